@@ -1,0 +1,29 @@
+# Unit tests: one gtest executable per test/unit/test_*.cpp, linked against the core only.
+# Node tests: one rostest per test/rostest/*.test, with its gtest node from test/rostest/*.cpp.
+find_package(rostest REQUIRED)
+
+file(GLOB DTM_UNIT_TESTS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/unit/test_*.cpp)
+foreach(test_source ${DTM_UNIT_TESTS})
+  get_filename_component(test_name ${test_source} NAME_WE)
+  catkin_add_gtest(${test_name} ${test_source})
+  target_link_libraries(${test_name} dtm_core ${GTEST_MAIN_LIBRARIES})
+  target_compile_definitions(${test_name} PRIVATE
+    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}")
+endforeach()
+
+file(GLOB DTM_ROSTEST_NODES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.cpp)
+foreach(test_source ${DTM_ROSTEST_NODES})
+  get_filename_component(test_name ${test_source} NAME_WE)
+  add_executable(${test_name} EXCLUDE_FROM_ALL ${test_source})
+  target_link_libraries(${test_name} dtm_ros ${GTEST_LIBRARIES})
+  target_include_directories(${test_name} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
+  target_compile_definitions(${test_name} PRIVATE
+    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}")
+  add_dependencies(tests ${test_name})
+endforeach()
+
+file(GLOB DTM_ROSTESTS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.test)
+foreach(launch_file ${DTM_ROSTESTS})
+  file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${launch_file})
+  add_rostest(${rel})
+endforeach()

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief One fitted cylinder (trunk segment or primary branch), in metres.
+struct CylinderModel {
+  int id = 0;                                        ///< unique within one TreeModel
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< middle of the axis segment
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< unit; trunk upwards, branch outwards
+  double diameter = 0.0;                             ///< m
+  double length = 0.0;                               ///< m, along the axis
+  std::size_t num_points = 0;                        ///< inliers supporting the fit
+  double inlier_ratio = 0.0;                         ///< inliers / segment points, 0..1
+};
+
+/// @brief Measurements of one primary branch that pruning decisions use.
+struct BranchMeasurement {
+  double attachment_height = 0.0;  ///< m above the lowest trunk point
+  double angle_to_trunk = 0.0;     ///< rad between branch axis and local trunk axis
+  double trunk_diameter = 0.0;     ///< m, trunk diameter at the attachment
+  double diameter_ratio = 0.0;     ///< branch diameter / trunk_diameter
+  bool prune = false;              ///< diameter_ratio above the configured limit
+};
+
+/// @brief A primary branch: its cylinder, the trunk cylinder it leaves, and its measurements.
+struct PrimaryBranch {
+  CylinderModel cylinder;
+  int trunk_segment = -1;  ///< id of the trunk cylinder the branch leaves
+  BranchMeasurement measurement;
+};
+
+/// @brief The model of one tree (docs/evaluation.md "model.json").
+struct TreeModel {
+  std::size_t input_points = 0;
+  std::vector<CylinderModel> trunk;  ///< bottom to top
+  std::vector<PrimaryBranch> primary_branches;
+  double runtime_s = 0.0;  ///< wall time of the modeler, s
+};
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

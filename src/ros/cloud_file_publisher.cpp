@@ -1,0 +1,49 @@
+#include "dormant_tree_modeling/ros/cloud_file_publisher.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/ros/conversions.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string file;
+  if (!pnh.getParam("file", file) || file.empty()) {
+    throw Error(ErrorCode::INVALID_ARGUMENT, "parameter ~file is required (a .pcd, .ply or .xyz)");
+  }
+  const std::string frame_id = pnh.param<std::string>("frame_id", "orchard");
+  const double rate = pnh.param("rate", 0.0);
+  if (!(rate >= 0.0)) {
+    throw Error(ErrorCode::INVALID_ARGUMENT, "parameter ~rate must be >= 0 Hz (0: publish once)");
+  }
+  const auto loaded = io::readCloud(file);
+  if (loaded.dropped_non_finite > 0) {
+    ROS_WARN("%s: dropped %zu NaN/Inf points of %zu", file.c_str(), loaded.dropped_non_finite,
+             loaded.points_in_file);
+  }
+  if (!loaded.offset.isZero()) {
+    ROS_INFO("%s: survey coordinates recentred; original = published + (%.3f, %.3f, %.3f)",
+             file.c_str(), loaded.offset.x(), loaded.offset.y(), loaded.offset.z());
+  }
+  msg_ = toMsg(*loaded.cloud, frame_id, ros::Time::now());
+  publisher_ = nh.advertise<sensor_msgs::PointCloud2>("cloud", 1, /*latch=*/true);
+  ROS_INFO("publishing %zu points from %s in frame '%s'%s", loaded.cloud->size(), file.c_str(),
+           frame_id.c_str(), rate > 0.0 ? "" : " (latched, once)");
+  publish();
+  if (rate > 0.0) {
+    timer_ =
+        nh.createTimer(ros::Duration(1.0 / rate), [this](const ros::TimerEvent&) { publish(); });
+  }
+}
+
+void CloudFilePublisher::publish() {
+  msg_.header.stamp = ros::Time::now();
+  publisher_.publish(msg_);
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling
