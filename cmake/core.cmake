@@ -12,7 +12,7 @@ target_include_directories(dtm_core PUBLIC ${PROJECT_SOURCE_DIR}/include)
 target_include_directories(dtm_core SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIRS} ${PCL_INCLUDE_DIRS})
 target_compile_definitions(dtm_core PUBLIC ${PCL_DEFINITIONS})
 target_link_libraries(dtm_core PUBLIC ${PCL_LIBRARIES} Boost::system Boost::thread
-                      nlohmann_json::nlohmann_json)
+                      Threads::Threads PRIVATE nlohmann_json::nlohmann_json yaml-cpp ${STB_LIBRARY})
 set_target_properties(dtm_core PROPERTIES POSITION_INDEPENDENT_CODE ON)
 
 # Command-line tools (src/tools/<name>.cpp -> <name>), ROS-free.
