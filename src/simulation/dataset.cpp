@@ -72,7 +72,8 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
   const Lms111Model model(caster, options.sensor);
   constexpr double DEG = M_PI / 180.0;
 
-  // One initial-guess error per platform position: slide moves between its views are exact.
+  // One initial-guess error per platform position, in the platform's own frame (odometry or an
+  // operator misjudging where the platform stands): slide moves between its views are exact.
   std::vector<Eigen::Isometry3d> guess_error;
   Rng guess_rng = Rng::derive(options.seed, 3);
   nlohmann::json views_doc = nlohmann::json::array();
@@ -88,7 +89,7 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
     }
     const Eigen::Isometry3d stage = acquisition::stagePose(v.platform, options.geometry, v.slide);
     const Eigen::Isometry3d guess_stage = acquisition::stagePose(
-        guess_error[v.platform_index] * v.platform, options.geometry, v.slide);
+        v.platform * guess_error[v.platform_index], options.geometry, v.slide);
     const SimulatedView sim = simulateView(model, stage, options.geometry, options.plan,
                                            options.seed, v.index, options.threads);
     // The tree and its surroundings lie in 0 <= phi < 180 deg; the rest looks behind the sensor.
