@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/simulation/random.h"
+#include "dormant_tree_modeling/common/random.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dormant_tree_modeling/simulation/random.h"
+#include "dormant_tree_modeling/common/random.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {

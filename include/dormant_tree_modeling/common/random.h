@@ -4,7 +4,6 @@
 #include <cstdint>
 
 namespace dormant_tree_modeling {
-namespace simulation {
 
 /// @brief Seeded random numbers that give the same sequence on every platform and standard
 /// library (std:: distributions are implementation-defined, so they are not used).
@@ -71,5 +70,4 @@ class Rng {
   bool has_spare_ = false;
 };
 
-}  // namespace simulation
 }  // namespace dormant_tree_modeling

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <vector>
+
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief One primary branch found on the trunk.
+struct BranchFit {
+  Cylinder cylinder;         ///< axis points away from the trunk
+  int trunk_segment = 0;     ///< index into TrunkModel::cylinders
+  std::vector<int> inliers;  ///< indices into the modeled cloud
+  Eigen::Vector3d attachment = Eigen::Vector3d::Zero();  ///< on the trunk axis
+};
+
+/// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
+/// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
+/// config.ours_branch_shell, every point of the cloud in a shell around the trunk cylinders.
+/// Candidates are grouped by Euclidean clustering, one cluster per branch, and a RANSAC
+/// cylinder is fitted to each cluster's part within branch_fit_length of the trunk surface.
+/// With config.ours_constrain_ransac a branch must leave the trunk surface: its axis points
+/// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
+/// crossing near the trunk do not), and duplicates of one branch are merged.
+std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk, const std::vector<int>& region,
+                                     const ModelerConfig& config);
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

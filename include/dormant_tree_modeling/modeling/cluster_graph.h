@@ -1,0 +1,59 @@
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief A cluster of points (indices into the modeled cloud) and its cylinder fit.
+struct Cluster {
+  std::vector<int> members;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  std::optional<Cylinder> fit;  ///< least-squares cylinder; empty when the fit failed
+  double error = 0.0;           ///< mean |d - r| of the fit (infinite without a fit)
+};
+
+/// @brief Recompute centroid, cylinder fit and error of a cluster.
+void updateCluster(const Points& pts, Cluster& cluster);
+
+/// @brief Step 1: k-means into N_c = |pts| / cluster_points clusters (k-means++ seeding).
+std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config);
+
+/// @brief e_t derived from the data: 1.5 x the 25th percentile of the clusters' fit errors
+/// (clean cylinder pieces sit at the noise floor), never below the configured e_t.
+double derivedSplitError(const std::vector<Cluster>& clusters, double configured);
+
+/// @brief Step 2: split every cluster whose fit error exceeds e_t in two (2-means) until all
+/// pass or reach 2 x min_cluster_points.
+std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clusters, double e_t,
+                                   const ModelerConfig& config);
+
+/// @brief Step 3: merge clusters whose centroids are closer than d_t, until none are.
+std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clusters, double d_t);
+
+/// @brief Step 4: adjacency lists of the bidirectional interface test: P_i and P_k are
+/// connected when, from both sides, the point p nearest to the other cluster has between n_L
+/// and n_H of its N nearest neighbours (in the whole cloud) in the other cluster.
+std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vector<Cluster>& clusters,
+                                              const ModelerConfig& config);
+
+/// @brief Result of step 5 and 6.
+struct TrunkPath {
+  std::vector<int> trunk;    ///< cluster indices, bottom to top
+  std::vector<int> primary;  ///< clusters adjacent to the trunk that are not trunk
+};
+
+/// @brief Step 5: from the start cluster follow, at each step, the edge with the smallest angle
+/// psi to the vertical while psi < psi_T (paper). With config.ours_follow_diameter the choice
+/// also weighs how well the next cluster's radius continues the trunk's, and the start is the
+/// low cluster nearest the cloud's horizontal centre (not merely the lowest).
+/// Step 6: primary-branch clusters.
+TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
+                        const ModelerConfig& config);
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

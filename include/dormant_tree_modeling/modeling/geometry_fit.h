@@ -1,0 +1,106 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+using Points = std::vector<Eigen::Vector3d>;
+using Points2 = std::vector<Eigen::Vector2d>;
+
+/// @brief A circle in a plane.
+struct Circle {
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  double radius = 0.0;
+};
+
+/// @brief A finite cylinder: axis through `center` along unit `axis`, radius, extent along
+/// the axis of the points it was fitted to.
+struct Cylinder {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< middle of the axis segment
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double radius = 0.0;
+  double length = 0.0;
+  double rms = 0.0;              ///< RMS of |distance to axis - radius| over the fitted points
+  double mean_abs_error = 0.0;   ///< mean |distance to axis - radius|
+  double mean_sq_distance = 0.0; ///< mean squared distance to the axis (for the noise correction)
+};
+
+/// @brief Distance of p to the infinite axis of c.
+double axisDistance(const Cylinder& c, const Eigen::Vector3d& p);
+
+/// @brief Circle through three points; nothing when they are (nearly) collinear.
+std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                    const Eigen::Vector2d& c);
+
+/// @brief Least-squares circle: algebraic (Kasa) start, then geometric Gauss-Newton.
+/// @returns nothing for fewer than 3 points or a degenerate configuration
+std::optional<Circle> fitCircle(const Points2& pts);
+
+/// @brief Options of ransacCircle().
+struct CircleRansacOptions {
+  double threshold = 0.005;  ///< m, inlier band around the circle
+  int iterations = 200;
+  double min_radius = 0.001;  ///< m
+  double max_radius = 1.0;    ///< m
+  std::uint64_t seed = 1;
+};
+
+/// @brief RANSAC circle with radius bounds, refined on its inliers (within the bounds).
+/// @param inliers set to the indices of the inliers of the result
+std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions& options,
+                                   std::vector<int>* inliers = nullptr);
+
+/// @brief Geometric least-squares cylinder (Gauss-Newton on axis, centre and radius) from an
+/// initial axis direction; the start comes from a circle fit in the plane orthogonal to it.
+/// @param pts at least 6 points
+/// @param axis_guess unit vector; its sign is kept in the result
+/// @param fixed_axis keep the axis direction fixed (fit centre and radius only)
+std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                    bool fixed_axis = false);
+
+/// @brief Principal direction (largest-variance eigenvector) and centroid of points.
+Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid = nullptr,
+                              Eigen::Vector3d* eigenvalues = nullptr);
+
+/// @brief Options of ransacCylinder().
+struct CylinderRansacOptions {
+  double threshold = 0.01;  ///< m, inlier band |d - r|
+  int circle_iterations = 150;
+  int axis_candidates = 12;       ///< axis directions tried around the guess
+  double max_axis_deviation = 0.5;  ///< rad, how far candidates may leave the guess
+  double min_radius = 0.002;
+  double max_radius = 0.5;
+  std::uint64_t seed = 1;
+};
+
+/// @brief RANSAC cylinder for points without normals: axis candidates around a guess (the
+/// guess, the principal axis when within the deviation bound, and seeded perturbations); for
+/// each, a RANSAC circle in the orthogonal plane; the candidate with most inliers is refined
+/// by fitCylinder() on its inliers. The radius stays within the bounds.
+/// @param inliers set to indices of the final inliers
+std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                       const CylinderRansacOptions& options,
+                                       std::vector<int>* inliers = nullptr);
+
+/// @brief Radius corrected for range noise: sqrt(mean d^2 - sigma^2) over the points closer
+/// to the axis than radius + `band`, never below `min_radius`. A return's squared distance to
+/// the axis is on average r^2 + sigma^2, so the plain fit estimates about sqrt(r^2 + sigma^2)
+/// (algorithms.md, PCL traps).
+
+double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
+                            double min_radius);
+
+/// @brief Deterministic k-means with k-means++ seeding from `seed`.
+/// @param pts points
+/// @param k clusters (clamped to the number of points)
+/// @param max_iterations Lloyd iterations at most
+/// @param seed seeding stream: equal inputs and seed give equal labels
+/// @returns the cluster index of every point (every cluster non-empty)
+std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint64_t seed);
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,30 @@
+#pragma once
+
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief What preprocessing removed, for the model's diagnostics.
+struct PreprocessStats {
+  std::size_t input = 0;
+  std::size_t after_voxel = 0;
+  std::size_t floating = 0;  ///< isolated returns and mixed pixels (Eq. 1's targets)
+  std::size_t ground = 0;
+  std::size_t wires = 0;
+};
+
+/// @brief Voxel-grid downsampling: the centroid of the points in each occupied voxel, in a
+/// deterministic order (sorted by voxel key).
+Points voxelDownsample(const Points& pts, double voxel);
+
+/// @brief Points with fewer than min_neighbors others within radius: floating pixels.
+std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors);
+
+/// @brief Downsample and, with config.ours_remove_clutter, drop floating pixels, the ground
+/// plane and trellis wires (long straight thin near-horizontal runs).
+Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats);
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/common/cloud.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/preprocess.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief Per-point class of the modeled (downsampled, cleaned) cloud.
+enum class PointClass : std::uint8_t { OTHER = 0, TRUNK = 1, PRIMARY = 2 };
+
+/// @brief Everything one modeling run produced.
+struct ModelResult {
+  TreeModel model;
+  Points points;                    ///< the cloud the model was computed from (preprocessed)
+  std::vector<PointClass> classes;  ///< one per entry of `points`
+  PreprocessStats preprocess;
+  double noise_sigma = 0.0;         ///< range noise estimate used (m)
+  double split_error = 0.0;         ///< e_t used (m)
+  int clusters = 0;                 ///< after split and merge
+  int trunk_clusters = 0;
+  int primary_clusters = 0;
+  std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
+};
+
+/// @brief Algorithms 2 and 3 of the paper (docs/algorithms.md), plus the switchable additions of
+/// ModelerConfig, from a point cloud of one tree to trunk and primary-branch cylinders.
+class TreeModeler {
+ public:
+  /// @param config validated here; @throws Error INVALID_ARGUMENT
+  explicit TreeModeler(const ModelerConfig& config);
+
+  /// @brief Model one tree.
+  /// @param cloud the tree, z up, in metres (finite points; readCloud drops NaN/Inf)
+  /// @throws Error EMPTY_INPUT for a cloud without enough points, NO_TRUNK when no trunk is found
+  ModelResult model(const Cloud& cloud) const;
+
+  /// @brief Same, from double-precision points.
+  ModelResult model(const Points& points) const;
+
+  const ModelerConfig& config() const { return config_; }
+
+ private:
+  ModelerConfig config_;
+};
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

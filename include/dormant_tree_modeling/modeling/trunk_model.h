@@ -1,0 +1,83 @@
+#pragma once
+
+#include <vector>
+
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief A polyline with arc-length projection, used as the trunk's centreline.
+class Centerline {
+ public:
+  Centerline() = default;
+  /// @param vertices at least two, bottom to top
+  explicit Centerline(std::vector<Eigen::Vector3d> vertices);
+  /// @brief Arc length of the projection of p (may be < 0 or > length() beyond the ends) and
+  /// the distance from p to the polyline.
+  double project(const Eigen::Vector3d& p, double* distance = nullptr) const;
+  /// @brief Point at arc length s (extrapolated beyond the ends).
+  Eigen::Vector3d pointAt(double s) const;
+  /// @brief Unit direction at arc length s.
+  Eigen::Vector3d directionAt(double s) const;
+  double length() const { return cumulative_.empty() ? 0.0 : cumulative_.back(); }
+  const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
+
+ private:
+  std::size_t segmentAt(double s) const;
+  std::vector<Eigen::Vector3d> vertices_;
+  std::vector<double> cumulative_;
+};
+
+/// @brief One slice of Algorithm 3 step 1.
+struct Slice {
+  double s0 = 0.0;                 ///< arc length of the slice's lower bound
+  int points = 0;
+  int outliers = 0;                ///< eta: points off the slice's RANSAC circle
+  double outlier_share = 0.0;      ///< outliers / points
+  bool has_circle = false;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< circle centre in 3-D
+  double radius = 0.0;
+  /// Radius corrected for range noise, sqrt(mean d^2 - sigma^2) over the slice's points closer
+  /// than radius + 2.5 sigma to the centre (equals radius when no noise estimate was given).
+  double corrected_radius = 0.0;
+};
+
+
+/// @brief The trunk as Algorithm 3 models it.
+struct TrunkModel {
+  Centerline centerline;           ///< refined by the slice circles
+  std::vector<Slice> slices;
+  std::vector<double> partitions;  ///< arc lengths of the segment bounds, first 0, last = top
+  std::vector<Cylinder> cylinders; ///< one per segment, bottom to top (failed fits left out)
+  std::vector<std::pair<double, double>> cylinder_ranges;  ///< arc-length range of each cylinder
+  double noise_sigma = 0.0;        ///< range noise used for the bias correction (m)
+};
+
+/// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
+/// parts: 1.4826 MAD of the radial residuals, x sqrt(3/2) because a return's radial residual
+/// carries on average 2/3 of its range variance. Nothing when too few slices qualify.
+double estimateNoiseSigma(const Points& pts, const Centerline& line, const std::vector<Slice>& slices,
+                          double slice_height);
+
+/// @brief Partition arc lengths from eta (step 2): where a positive derivative follows a run of
+/// at least `zero_run` near-zero derivatives. Includes 0 and the top.
+std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height,
+                                          int zero_run, double top);
+
+/// @brief Algorithm 3 steps 1-4 on the trunk region.
+/// @param pts the modeled cloud
+/// @param region indices of trunk (and primary-cluster) points
+/// @param initial_axis initial centreline points, bottom to top (e.g. trunk cluster centroids;
+///        smoothed by a robust cubic fit)
+/// @param initial_radius typical trunk radius (e.g. median of the trunk clusters' fits), or 0;
+///        slice circles stay within 0.3x..2.5x of it
+/// @throws Error NO_TRUNK when no trunk cylinder can be fitted
+TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
+                      const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
+                      const ModelerConfig& config);
+
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

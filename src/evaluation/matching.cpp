@@ -1,0 +1,216 @@
+#include "dormant_tree_modeling/evaluation/matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dormant_tree_modeling {
+namespace evaluation {
+
+PolylinePoint closestPoint(const Polyline& line, const Eigen::Vector3d& q) {
+  PolylinePoint best;
+  best.distance = std::numeric_limits<double>::infinity();
+  double arc = 0.0;
+  for (std::size_t i = 0; i + 1 < line.points.size(); ++i) {
+    const Eigen::Vector3d a = line.points[i], ab = line.points[i + 1] - a;
+    const double len = ab.norm();
+    if (len <= 0.0) continue;
+    const double t = std::clamp((q - a).dot(ab) / (len * len), 0.0, 1.0);
+    const Eigen::Vector3d p = a + t * ab;
+    const double d = (p - q).norm();
+    if (d < best.distance) {
+      best.distance = d;
+      best.point = p;
+      best.arc_length = arc + t * len;
+      best.diameter = line.diameters[i] + t * (line.diameters[i + 1] - line.diameters[i]);
+      best.direction = ab / len;
+    }
+    arc += len;
+  }
+  return best;
+}
+
+bool canMatch(const modeling::CylinderModel& detection, const Polyline& line, const MatchBounds& bounds, double* e,
+              PolylinePoint* at) {
+  const PolylinePoint q = closestPoint(line, detection.center);
+  if (e) *e = q.distance;
+  if (at) *at = q;
+  const double angle = std::acos(std::min(1.0, std::abs(detection.axis.normalized().dot(q.direction))));
+  return q.distance <= std::max(bounds.min_distance, q.diameter) && q.arc_length <= bounds.max_arc_length &&
+         angle <= bounds.max_angle_deg * M_PI / 180.0;
+}
+
+std::vector<int> assign(const std::vector<std::vector<double>>& cost, double forbidden) {
+  const int rows = static_cast<int>(cost.size());
+  const int cols = rows > 0 ? static_cast<int>(cost[0].size()) : 0;
+  std::vector<int> result(rows, -1);
+  if (rows == 0 || cols == 0) return result;
+  // Square the problem (Kuhn-Munkres with potentials, O(n^3)); padding costs `forbidden`.
+  const int n = std::max(rows, cols);
+  auto c = [&](int i, int j) { return i < rows && j < cols ? std::min(cost[i][j], forbidden) : forbidden; };
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(n + 1, 0.0), v(n + 1, 0.0);
+  std::vector<int> p(n + 1, 0), way(n + 1, 0);
+  for (int i = 1; i <= n; ++i) {
+    p[0] = i;
+    int j0 = 0;
+    std::vector<double> minv(n + 1, inf);
+    std::vector<char> used(n + 1, 0);
+    do {
+      used[j0] = 1;
+      const int i0 = p[j0];
+      double delta = inf;
+      int j1 = 0;
+      for (int j = 1; j <= n; ++j) {
+        if (used[j]) continue;
+        const double cur = c(i0 - 1, j - 1) - u[i0] - v[j];
+        if (cur < minv[j]) {
+          minv[j] = cur;
+          way[j] = j0;
+        }
+        if (minv[j] < delta) {
+          delta = minv[j];
+          j1 = j;
+        }
+      }
+      for (int j = 0; j <= n; ++j) {
+        if (used[j]) {
+          u[p[j]] += delta;
+          v[j] -= delta;
+        } else {
+          minv[j] -= delta;
+        }
+      }
+      j0 = j1;
+    } while (p[j0] != 0);
+    do {
+      const int j1 = way[j0];
+      p[j0] = p[j1];
+      j0 = j1;
+    } while (j0 != 0);
+  }
+  for (int j = 1; j <= n; ++j) {
+    const int i = p[j] - 1, col = j - 1;
+    if (i < rows && col < cols && cost[i][col] < forbidden) result[i] = col;
+  }
+  return result;
+}
+
+TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, const MatchBounds& bounds) {
+  constexpr double FORBIDDEN = 1e9;
+  TreeScore s;
+  s.pb = static_cast<int>(truth.primary_branches.size());
+  s.runtime_s = model.runtime_s;
+  const int detections = static_cast<int>(model.primary_branches.size());
+  std::vector<std::vector<double>> cost(detections, std::vector<double>(s.pb, FORBIDDEN));
+  std::vector<char> any_primary(detections, 0);
+  for (int d = 0; d < detections; ++d) {
+    for (int t = 0; t < s.pb; ++t) {
+      double e = 0.0;
+      if (canMatch(model.primary_branches[d].cylinder, truth.primary_branches[t], bounds, &e)) {
+        cost[d][t] = e;
+        any_primary[d] = 1;
+      }
+    }
+  }
+  const auto assignment = assign(cost, FORBIDDEN);
+  double sq = 0.0;
+  for (int d = 0; d < detections; ++d) {
+    if (assignment[d] >= 0) {
+      PolylinePoint at;
+      double e = 0.0;
+      canMatch(model.primary_branches[d].cylinder, truth.primary_branches[assignment[d]], bounds, &e, &at);
+      BranchMatch m{d, assignment[d], e, model.primary_branches[d].cylinder.diameter, at.diameter};
+      const double err = m.detected_diameter - m.true_diameter;
+      s.branch_mae += std::abs(err);
+      s.branch_bias += err;
+      sq += err * err;
+      s.matches.push_back(m);
+      continue;
+    }
+    bool minor = false;
+    if (!any_primary[d]) {
+      for (const auto& m : truth.minor_branches) minor = minor || canMatch(model.primary_branches[d].cylinder, m, bounds);
+    }
+    if (minor) {
+      ++s.ignored;
+    } else {
+      ++s.fp;
+    }
+  }
+  s.tp = static_cast<int>(s.matches.size());
+  s.fn = s.pb - s.tp;
+  s.ipb = detections - s.ignored;
+  if (s.tp > 0) {
+    s.branch_mae /= s.tp;
+    s.branch_bias /= s.tp;
+    s.branch_rmse = std::sqrt(sq / s.tp);
+  }
+  s.fp_rate = s.pb > 0 ? static_cast<double>(s.fp) / s.pb : 0.0;
+  s.fn_rate = s.pb > 0 ? static_cast<double>(s.fn) / s.pb : 0.0;
+  const int denom = 2 * s.tp + s.fp + s.fn;
+  s.f1 = denom > 0 ? 2.0 * s.tp / denom : 1.0;
+
+  // Trunk.
+  double weight = 0.0, weighted = 0.0, centre_sum = 0.0;
+  int centre_n = 0;
+  std::vector<std::pair<double, double>> spans;
+  for (const auto& c : model.trunk) {
+    const PolylinePoint q = closestPoint(truth.trunk, c.center);
+    weighted += c.length * std::abs(c.diameter - q.diameter);
+    weight += c.length;
+    for (int k = 0; k <= 4; ++k) {
+      const Eigen::Vector3d p = c.center + (k / 4.0 - 0.5) * c.length * c.axis;
+      centre_sum += closestPoint(truth.trunk, p).distance;
+      ++centre_n;
+    }
+    const double a = closestPoint(truth.trunk, c.center - 0.5 * c.length * c.axis).arc_length;
+    const double b = closestPoint(truth.trunk, c.center + 0.5 * c.length * c.axis).arc_length;
+    spans.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  s.trunk_mae = weight > 0.0 ? weighted / weight : 0.0;
+  s.centerline_error = centre_n > 0 ? centre_sum / centre_n : 0.0;
+  double top = 0.0;
+  for (const auto& b : truth.primary_branches) top = std::max(top, closestPoint(truth.trunk, b.points.front()).arc_length);
+  if (top <= 0.0) top = closestPoint(truth.trunk, truth.trunk.points.back()).arc_length;
+  std::sort(spans.begin(), spans.end());
+  double covered = 0.0, reach = 0.0;
+  for (const auto& sp : spans) {
+    const double a = std::max(sp.first, reach), b = std::min(sp.second, top);
+    if (b > a) covered += b - a;
+    reach = std::max(reach, sp.second);
+  }
+  s.coverage = top > 0.0 ? std::min(1.0, covered / top) : 0.0;
+  return s;
+}
+
+TreeScore meanScore(const std::vector<TreeScore>& scores) {
+  TreeScore m;
+  m.name = "mean";
+  if (scores.empty()) return m;
+  const double n = static_cast<double>(scores.size());
+  double pb = 0, ipb = 0;
+  for (const auto& s : scores) {
+    pb += s.pb;
+    ipb += s.ipb;
+    m.tp += s.tp;
+    m.fp += s.fp;
+    m.fn += s.fn;
+    m.fp_rate += s.fp_rate / n;
+    m.fn_rate += s.fn_rate / n;
+    m.f1 += s.f1 / n;
+    m.branch_mae += s.branch_mae / n;
+    m.branch_rmse += s.branch_rmse / n;
+    m.branch_bias += s.branch_bias / n;
+    m.trunk_mae += s.trunk_mae / n;
+    m.centerline_error += s.centerline_error / n;
+    m.coverage += s.coverage / n;
+    m.runtime_s += s.runtime_s / n;
+  }
+  m.pb = static_cast<int>(std::lround(pb / n));
+  m.ipb = static_cast<int>(std::lround(ipb / n));
+  return m;
+}
+
+}  // namespace evaluation
+}  // namespace dormant_tree_modeling

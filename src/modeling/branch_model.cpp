@@ -1,0 +1,179 @@
+#include "dormant_tree_modeling/modeling/branch_model.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "dormant_tree_modeling/modeling/point_index.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+constexpr double MIN_BRANCH_RADIUS = 0.002;
+constexpr double SURFACE_CONTACT = 0.05;  // m: a branch's nearest points lie this close to the trunk
+
+/// Where a point sits relative to the trunk model.
+struct TrunkCoords {
+  int segment = -1;
+  double s = 0.0;
+  double distance = 0.0;  // to the segment cylinder's axis
+};
+
+TrunkCoords locate(const TrunkModel& trunk, const Eigen::Vector3d& p) {
+  TrunkCoords c;
+  c.s = trunk.centerline.project(p);
+  double best = 1e300;
+  for (std::size_t i = 0; i < trunk.cylinder_ranges.size(); ++i) {
+    const auto& r = trunk.cylinder_ranges[i];
+    const double gap = c.s < r.first ? r.first - c.s : (c.s > r.second ? c.s - r.second : 0.0);
+    if (gap < best) {
+      best = gap;
+      c.segment = static_cast<int>(i);
+    }
+  }
+  if (c.segment >= 0) c.distance = axisDistance(trunk.cylinders[c.segment], p);
+  return c;
+}
+
+/// Closest points between two lines p + t u and q + s v: returns the point on the first line
+/// and the distance between the lines.
+double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& q,
+               const Eigen::Vector3d& v, Eigen::Vector3d* on_second) {
+  const Eigen::Vector3d w = p - q;
+  const double a = u.dot(u), b = u.dot(v), c = v.dot(v), d = u.dot(w), e = v.dot(w);
+  const double den = a * c - b * b;
+  double t = 0.0, s = 0.0;
+  if (std::abs(den) > 1e-12) {
+    t = (b * e - c * d) / den;
+    s = (a * e - b * d) / den;
+  } else {
+    s = e / c;
+  }
+  const Eigen::Vector3d x = p + t * u, y = q + s * v;
+  if (on_second) *on_second = y;
+  return (x - y).norm();
+}
+
+}  // namespace
+
+std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk, const std::vector<int>& region,
+                                     const ModelerConfig& config) {
+  std::vector<BranchFit> branches;
+  if (trunk.cylinders.empty()) return branches;
+  const double sigma = trunk.noise_sigma;
+  double threshold = config.cylinder_threshold;
+  if (config.ours_derive_parameters) threshold = std::max(threshold, 2.5 * sigma);
+  const double s_lo = trunk.cylinder_ranges.front().first - 0.05;
+  const double s_hi = trunk.cylinder_ranges.back().second + 0.05;
+
+  // Candidate points and where they sit.
+  std::vector<int> candidates;
+  std::vector<TrunkCoords> where;
+  auto consider = [&](int i) {
+    const TrunkCoords c = locate(trunk, pts[i]);
+    if (c.segment < 0 || c.s < s_lo || c.s > s_hi) return;
+    const double r = trunk.cylinders[c.segment].radius;
+    if (c.distance <= r + threshold) return;  // on the trunk surface
+    if (config.ours_branch_shell && c.distance > r + config.branch_fit_length + 0.05) return;
+    candidates.push_back(i);
+    where.push_back(c);
+  };
+  if (config.ours_branch_shell) {
+    for (std::size_t i = 0; i < pts.size(); ++i) consider(static_cast<int>(i));
+  } else {
+    for (const int i : region) consider(i);
+  }
+  Points cand_pts;
+  for (const int i : candidates) cand_pts.push_back(pts[i]);
+  const auto clusters = euclideanClusters(cand_pts, config.branch_cluster_tolerance, config.branch_min_points);
+
+  std::uint64_t stream = 0;
+  for (const auto& cluster : clusters) {
+    // The part of the branch near the trunk: where diameters are measured and pruning cuts.
+    Points sub;
+    std::vector<int> sub_index;
+    double nearest_gap = 1e300;
+    int segment = where[cluster.front()].segment;
+    double min_d = 1e300;
+    for (const int k : cluster) {
+      const double r = trunk.cylinders[where[k].segment].radius;
+      const double gap = where[k].distance - r;
+      nearest_gap = std::min(nearest_gap, gap);
+      if (gap < min_d) {
+        min_d = gap;
+        segment = where[k].segment;
+      }
+      if (gap <= config.branch_fit_length) {
+        sub.push_back(cand_pts[k]);
+        sub_index.push_back(candidates[k]);
+      }
+    }
+    if (static_cast<int>(sub.size()) < config.branch_min_points) continue;
+    const Cylinder& seg = trunk.cylinders[segment];
+    Eigen::Vector3d centroid;
+    Eigen::Vector3d axis = principalAxis(sub, &centroid);
+    Eigen::Vector3d radial = (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
+    if (radial.norm() < 1e-9) continue;
+    radial.normalize();
+    if (axis.dot(radial) < 0.0) axis = -axis;
+    const double max_angle = config.branch_max_radial_angle * DEG;
+    if (config.ours_constrain_ransac && std::acos(std::clamp(axis.dot(radial), -1.0, 1.0)) > max_angle) axis = radial;
+    CylinderRansacOptions o;
+    o.threshold = threshold;
+    o.circle_iterations = config.ransac_iterations / 2;
+    o.axis_candidates = 8;
+    o.max_axis_deviation = config.ours_constrain_ransac ? 30.0 * DEG : 35.0 * DEG;
+    o.min_radius = MIN_BRANCH_RADIUS;
+    o.max_radius = config.ours_constrain_ransac ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : 0.3;
+    o.seed = config.seed * 15485863ULL + stream++;
+    std::vector<int> inliers;
+    auto cyl = ransacCylinder(sub, axis, o, &inliers);
+    if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points) continue;
+    if (cyl->axis.dot(radial) < 0.0) cyl->axis = -cyl->axis;
+    Eigen::Vector3d attachment;
+    const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
+    if (config.ours_constrain_ransac) {
+      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle) continue;
+      if (gap > seg.radius + config.branch_axis_gap) continue;
+      if (nearest_gap > SURFACE_CONTACT + threshold) continue;
+    }
+    Points in;
+    BranchFit fit;
+    for (const int i : inliers) {
+      in.push_back(sub[i]);
+      fit.inliers.push_back(sub_index[i]);
+    }
+    if (config.ours_correct_noise_bias) {
+      cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_BRANCH_RADIUS);
+    }
+    fit.cylinder = *cyl;
+    fit.trunk_segment = segment;
+    fit.attachment = attachment;
+    branches.push_back(std::move(fit));
+  }
+  if (config.ours_constrain_ransac) {
+    // One branch split into two clusters (a gap in its returns) appears twice: keep the larger.
+    std::vector<char> drop(branches.size(), 0);
+    for (std::size_t i = 0; i < branches.size(); ++i) {
+      for (std::size_t k = i + 1; k < branches.size(); ++k) {
+        if (drop[i] || drop[k]) continue;
+        const double angle = std::acos(std::clamp(branches[i].cylinder.axis.dot(branches[k].cylinder.axis), -1.0, 1.0));
+        if ((branches[i].attachment - branches[k].attachment).norm() < 0.06 && angle < 25.0 * DEG) {
+          drop[branches[i].inliers.size() >= branches[k].inliers.size() ? k : i] = 1;
+        }
+      }
+    }
+    std::vector<BranchFit> kept;
+    for (std::size_t i = 0; i < branches.size(); ++i) {
+      if (!drop[i]) kept.push_back(std::move(branches[i]));
+    }
+    branches.swap(kept);
+  }
+  return branches;
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,261 @@
+#include "dormant_tree_modeling/modeling/cluster_graph.h"
+
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "dormant_tree_modeling/modeling/point_index.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+constexpr int MAX_CLUSTERS = 20000;
+constexpr double LINK_MARGIN = 0.02;  // m: clusters whose boxes are farther apart never touch
+
+Points gather(const Points& pts, const std::vector<int>& idx) {
+  Points out;
+  out.reserve(idx.size());
+  for (const int i : idx) out.push_back(pts[i]);
+  return out;
+}
+
+double angleToVertical(const Eigen::Vector3d& d) {
+  return std::acos(std::clamp(d.normalized().z(), -1.0, 1.0));
+}
+
+}  // namespace
+
+void updateCluster(const Points& pts, Cluster& c) {
+  const Points sub = gather(pts, c.members);
+  Eigen::Vector3d centroid;
+  const Eigen::Vector3d axis = principalAxis(sub, &centroid);
+  c.centroid = centroid;
+  c.fit = sub.size() >= 6 ? fitCylinder(sub, axis.z() < 0 ? Eigen::Vector3d(-axis) : axis) : std::nullopt;
+  c.error = c.fit ? c.fit->mean_abs_error : std::numeric_limits<double>::infinity();
+}
+
+std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config) {
+  const int k = std::max(1, static_cast<int>(pts.size() / static_cast<std::size_t>(config.cluster_points)));
+  const auto labels = kMeans(pts, k, config.kmeans_iterations, config.seed);
+  int count = 0;
+  for (const int l : labels) count = std::max(count, l + 1);
+  std::vector<Cluster> clusters(count);
+  for (std::size_t i = 0; i < labels.size(); ++i) clusters[labels[i]].members.push_back(static_cast<int>(i));
+  for (auto& c : clusters) updateCluster(pts, c);
+  return clusters;
+}
+
+double derivedSplitError(const std::vector<Cluster>& clusters, double configured) {
+  std::vector<double> errors;
+  for (const auto& c : clusters) {
+    if (std::isfinite(c.error)) errors.push_back(c.error);
+  }
+  if (errors.empty()) return configured;
+  const std::size_t q = errors.size() / 4;
+  std::nth_element(errors.begin(), errors.begin() + q, errors.end());
+  return std::max(configured, 1.5 * errors[q]);
+}
+
+std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clusters, double e_t,
+                                   const ModelerConfig& config) {
+  std::vector<Cluster> done;
+  std::uint64_t stream = 0;
+  while (!clusters.empty()) {
+    Cluster c = std::move(clusters.back());
+    clusters.pop_back();
+    const bool small = static_cast<int>(c.members.size()) < 2 * config.min_cluster_points;
+    if (c.error <= e_t || small || static_cast<int>(done.size() + clusters.size()) >= MAX_CLUSTERS) {
+      done.push_back(std::move(c));
+      continue;
+    }
+    const auto labels = kMeans(gather(pts, c.members), 2, config.kmeans_iterations, config.seed + 101 + stream++);
+    Cluster halves[2];
+    for (std::size_t i = 0; i < labels.size(); ++i) halves[labels[i]].members.push_back(c.members[i]);
+    if (halves[1].members.empty()) {
+      done.push_back(std::move(c));
+      continue;
+    }
+    for (auto& h : halves) {
+      updateCluster(pts, h);
+      clusters.push_back(std::move(h));
+    }
+  }
+  return done;
+}
+
+std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clusters, double d_t) {
+  for (bool merged = true; merged;) {
+    merged = false;
+    const int n = static_cast<int>(clusters.size());
+    std::vector<int> parent(n);
+    std::iota(parent.begin(), parent.end(), 0);
+    std::function<int(int)> find = [&](int i) { return parent[i] == i ? i : parent[i] = find(parent[i]); };
+    for (int i = 0; i < n; ++i) {
+      for (int k = i + 1; k < n; ++k) {
+        if ((clusters[i].centroid - clusters[k].centroid).norm() < d_t && find(i) != find(k)) {
+          parent[find(k)] = find(i);
+          merged = true;
+        }
+      }
+    }
+    if (!merged) break;
+    std::vector<Cluster> next;
+    std::vector<int> slot(n, -1);
+    for (int i = 0; i < n; ++i) {
+      const int r = find(i);
+      if (slot[r] < 0) {
+        slot[r] = static_cast<int>(next.size());
+        next.emplace_back();
+      }
+      auto& m = next[slot[r]].members;
+      m.insert(m.end(), clusters[i].members.begin(), clusters[i].members.end());
+    }
+    for (auto& c : next) {
+      std::sort(c.members.begin(), c.members.end());
+      updateCluster(pts, c);
+    }
+    clusters.swap(next);
+  }
+  return clusters;
+}
+
+std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vector<Cluster>& clusters,
+                                              const ModelerConfig& config) {
+  const int n = static_cast<int>(clusters.size());
+  std::vector<int> owner(pts.size(), -1);
+  std::vector<Eigen::Vector3d> lo(n), hi(n);
+  std::vector<std::unique_ptr<PointIndex>> index(n);
+  for (int c = 0; c < n; ++c) {
+    lo[c] = Eigen::Vector3d::Constant(1e300);
+    hi[c] = -lo[c];
+    for (const int i : clusters[c].members) {
+      owner[i] = c;
+      lo[c] = lo[c].cwiseMin(pts[i]);
+      hi[c] = hi[c].cwiseMax(pts[i]);
+    }
+    index[c] = std::make_unique<PointIndex>(gather(pts, clusters[c].members));
+  }
+  const PointIndex all(pts);
+  // The point of `from` nearest to cluster `to`, and the share of its N neighbours in `to`.
+  auto share = [&](int from, int to) {
+    double best = std::numeric_limits<double>::infinity();
+    int best_point = -1;
+    for (const int i : clusters[from].members) {
+      const Eigen::Vector3d& p = pts[i];
+      if (((p.array() < lo[to].array() - LINK_MARGIN) || (p.array() > hi[to].array() + LINK_MARGIN)).any()) continue;
+      const auto nn = index[to]->nearest(p, 1);
+      const double d = (pts[clusters[to].members[nn[0]]] - p).squaredNorm();
+      if (d < best) {
+        best = d;
+        best_point = i;
+      }
+    }
+    if (best_point < 0) return 0.0;
+    const auto nn = all.nearest(pts[best_point], config.graph_neighbors);
+    int inside = 0;
+    for (const int j : nn) inside += owner[j] == to;
+    return static_cast<double>(inside) / static_cast<double>(nn.size());
+  };
+  std::vector<std::vector<int>> adjacency(n);
+  for (int i = 0; i < n; ++i) {
+    for (int k = i + 1; k < n; ++k) {
+      if (((lo[i].array() > hi[k].array() + LINK_MARGIN) || (lo[k].array() > hi[i].array() + LINK_MARGIN)).any()) {
+        continue;
+      }
+      const double a = share(i, k);
+      if (a < config.n_low || a > config.n_high) continue;
+      const double b = share(k, i);
+      if (b < config.n_low || b > config.n_high) continue;
+      adjacency[i].push_back(k);
+      adjacency[k].push_back(i);
+    }
+  }
+  return adjacency;
+}
+
+TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
+                        const ModelerConfig& config) {
+  TrunkPath path;
+  const int n = static_cast<int>(clusters.size());
+  if (n == 0) return path;
+  double zmin = std::numeric_limits<double>::infinity();
+  int start = 0;
+  for (int c = 0; c < n; ++c) {
+    if (clusters[c].centroid.z() < zmin) {
+      zmin = clusters[c].centroid.z();
+      start = c;
+    }
+  }
+  if (config.ours_follow_diameter) {
+    // The target stands in the middle of its crop; a post or a neighbour's low branch does not.
+    std::vector<double> xs, ys;
+    for (const auto& c : clusters) {
+      xs.push_back(c.centroid.x());
+      ys.push_back(c.centroid.y());
+    }
+    std::nth_element(xs.begin(), xs.begin() + n / 2, xs.end());
+    std::nth_element(ys.begin(), ys.begin() + n / 2, ys.end());
+    const Eigen::Vector2d middle(xs[n / 2], ys[n / 2]);
+    double best = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < n; ++c) {
+      if (clusters[c].centroid.z() > zmin + 0.3 || adjacency[c].empty()) continue;
+      const double d = (clusters[c].centroid.head<2>() - middle).norm();
+      if (d < best) {
+        best = d;
+        start = c;
+      }
+    }
+  }
+  std::vector<char> in_trunk(n, 0);
+  path.trunk.push_back(start);
+  in_trunk[start] = 1;
+  const double psi_t = config.psi_t * DEG;
+  auto radius = [&](int c) { return clusters[c].fit ? clusters[c].fit->radius : 0.0; };
+  for (;;) {
+    const int cur = path.trunk.back();
+    // Reference radius: median of the last three trunk clusters with a fit.
+    std::vector<double> recent;
+    for (auto it = path.trunk.rbegin(); it != path.trunk.rend() && recent.size() < 3; ++it) {
+      if (radius(*it) > 0.0) recent.push_back(radius(*it));
+    }
+    std::sort(recent.begin(), recent.end());
+    const double r_ref = recent.empty() ? 0.0 : recent[recent.size() / 2];
+    int next = -1;
+    double best = std::numeric_limits<double>::infinity();
+    for (const int k : adjacency[cur]) {
+      if (in_trunk[k]) continue;
+      const double psi = angleToVertical(clusters[k].centroid - clusters[cur].centroid);
+      if (psi >= psi_t) continue;
+      double score = psi;
+      if (config.ours_follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
+        score = psi / psi_t + std::abs(std::log(radius(k) / r_ref));
+      }
+      if (score < best) {
+        best = score;
+        next = k;
+      }
+    }
+    if (next < 0) break;
+    path.trunk.push_back(next);
+    in_trunk[next] = 1;
+  }
+  std::vector<char> seen(n, 0);
+  for (const int t : path.trunk) {
+    for (const int k : adjacency[t]) {
+      if (!in_trunk[k] && !seen[k]) {
+        seen[k] = 1;
+        path.primary.push_back(k);
+      }
+    }
+  }
+  return path;
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,186 @@
+#include "dormant_tree_modeling/modeling/preprocess.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+constexpr double GROUND_BAND = 0.03;         // m above the ground plane removed with it
+constexpr double GROUND_MIN_EXTENT = 0.8;    // m: a plane smaller than this is not the ground
+constexpr double WIRE_BAND = 0.012;          // m around a wire line
+constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
+constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
+constexpr int MAX_WIRES = 10;
+
+/// Removes points near a near-horizontal plane at the bottom of the cloud, if it is large.
+std::size_t removeGround(Points& pts, std::uint64_t seed) {
+  if (pts.size() < 100) return 0;
+  double zmin = 1e300;
+  for (const auto& p : pts) zmin = std::min(zmin, p.z());
+  std::vector<int> low;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].z() < zmin + 0.15) low.push_back(static_cast<int>(i));
+  }
+  if (low.size() < 50) return 0;
+  Rng rng(seed);
+  Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
+  double best_d = 0.0;
+  std::size_t best_count = 0;
+  for (int it = 0; it < 200; ++it) {
+    const auto& a = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
+    const auto& b = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
+    const auto& c = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    if (n.norm() < 1e-9) continue;
+    n.normalize();
+    if (n.z() < 0) n = -n;
+    if (n.z() < std::cos(15.0 * M_PI / 180.0)) continue;
+    const double d = -n.dot(a);
+    std::size_t count = 0;
+    for (const int i : low) count += std::abs(n.dot(pts[i]) + d) < 0.02;
+    if (count > best_count) {
+      best_count = count;
+      best_n = n;
+      best_d = d;
+    }
+  }
+  // The plane must be wide in both horizontal directions: a trunk base is not the ground.
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const int i : low) {
+    if (std::abs(best_n.dot(pts[i]) + best_d) < 0.02) {
+      lo = lo.cwiseMin(pts[i].head<2>());
+      hi = hi.cwiseMax(pts[i].head<2>());
+    }
+  }
+  if (best_count < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT) return 0;
+  const std::size_t before = pts.size();
+  pts.erase(std::remove_if(pts.begin(), pts.end(),
+                           [&](const Eigen::Vector3d& p) { return best_n.dot(p) + best_d < GROUND_BAND; }),
+            pts.end());
+  return before - pts.size();
+}
+
+/// Longest run of projections along a line without a gap above WIRE_MAX_GAP.
+double longestRun(std::vector<double>& t) {
+  if (t.empty()) return 0.0;
+  std::sort(t.begin(), t.end());
+  double best = 0.0, start = t[0];
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i] - t[i - 1] > WIRE_MAX_GAP) start = t[i];
+    best = std::max(best, t[i] - start);
+  }
+  return best;
+}
+
+std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
+  std::size_t removed = 0;
+  Rng rng(seed);
+  for (int wire = 0; wire < MAX_WIRES && pts.size() > 100; ++wire) {
+    const int n = static_cast<int>(pts.size());
+    // Score candidate lines on a sample, verify the best on all points.
+    std::vector<int> sample;
+    for (int i = 0; i < std::min(n, 4000); ++i) sample.push_back(rng.uniformInt(0, n - 1));
+    Eigen::Vector3d best_o = Eigen::Vector3d::Zero(), best_d = Eigen::Vector3d::UnitX();
+    std::size_t best_count = 0;
+    for (int it = 0; it < 400; ++it) {
+      const auto& a = pts[sample[rng.uniformInt(0, static_cast<int>(sample.size()) - 1)]];
+      const auto& b = pts[sample[rng.uniformInt(0, static_cast<int>(sample.size()) - 1)]];
+      Eigen::Vector3d d = b - a;
+      if (d.norm() < 0.5 * min_length) continue;
+      d.normalize();
+      if (std::abs(d.z()) > std::sin(WIRE_MAX_TILT)) continue;
+      std::size_t count = 0;
+      for (const int i : sample) {
+        const Eigen::Vector3d w = pts[i] - a;
+        count += (w - w.dot(d) * d).squaredNorm() < WIRE_BAND * WIRE_BAND;
+      }
+      if (count > best_count) {
+        best_count = count;
+        best_o = a;
+        best_d = d;
+      }
+    }
+    if (best_count < 5) break;
+    std::vector<double> along;
+    std::vector<int> inliers;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d w = pts[i] - best_o;
+      if ((w - w.dot(best_d) * best_d).squaredNorm() < WIRE_BAND * WIRE_BAND) {
+        inliers.push_back(i);
+        along.push_back(w.dot(best_d));
+      }
+    }
+    if (longestRun(along) < min_length) break;
+    std::vector<char> drop(n, 0);
+    for (const int i : inliers) drop[i] = 1;
+    Points kept;
+    kept.reserve(n - inliers.size());
+    for (int i = 0; i < n; ++i) {
+      if (!drop[i]) kept.push_back(pts[i]);
+    }
+    removed += inliers.size();
+    pts.swap(kept);
+  }
+  return removed;
+}
+
+}  // namespace
+
+Points voxelDownsample(const Points& pts, double voxel) {
+  if (voxel <= 0.0) return pts;
+  std::map<std::tuple<long, long, long>, std::pair<Eigen::Vector3d, int>> cells;
+  for (const auto& p : pts) {
+    const auto key = std::make_tuple(static_cast<long>(std::floor(p.x() / voxel)),
+                                     static_cast<long>(std::floor(p.y() / voxel)),
+                                     static_cast<long>(std::floor(p.z() / voxel)));
+    // Eigen leaves a default-constructed vector uninitialised: start each cell explicitly.
+    auto it = cells.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
+    it->second.first += p;
+    ++it->second.second;
+
+  }
+  Points out;
+  out.reserve(cells.size());
+  for (const auto& kv : cells) out.push_back(kv.second.first / kv.second.second);
+  return out;
+}
+
+std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
+  std::vector<char> mask(pts.size(), 0);
+  const PointIndex index(pts);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    mask[i] = index.countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
+  }
+  return mask;
+}
+
+Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats) {
+  PreprocessStats s;
+  s.input = pts.size();
+  Points out = voxelDownsample(pts, config.voxel_size);
+  s.after_voxel = out.size();
+  if (config.ours_remove_clutter) {
+    const auto mask = floatingMask(out, config.floating_radius, config.floating_min_neighbors);
+    Points kept;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (!mask[i]) kept.push_back(out[i]);
+    }
+    s.floating = out.size() - kept.size();
+    out.swap(kept);
+    s.ground = removeGround(out, config.seed + 11);
+    s.wires = removeWires(out, config.wire_min_length, config.seed + 13);
+  }
+  if (stats) *stats = s;
+  return out;
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,165 @@
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/modeling/branch_model.h"
+#include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+constexpr std::size_t MIN_POINTS = 100;
+
+class Stopwatch {
+ public:
+  explicit Stopwatch(std::vector<std::pair<std::string, double>>& out) : out_(out) {}
+  void lap(const std::string& name) {
+    const auto now = std::chrono::steady_clock::now();
+    out_.emplace_back(name, std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>>& out_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+CylinderModel toModel(const Cylinder& c, int id, std::size_t inliers, std::size_t total) {
+  CylinderModel m;
+  m.id = id;
+  m.center = c.center;
+  m.axis = c.axis;
+  m.diameter = 2.0 * c.radius;
+  m.length = c.length;
+  m.num_points = inliers;
+  m.inlier_ratio = total > 0 ? static_cast<double>(inliers) / static_cast<double>(total) : 0.0;
+  return m;
+}
+
+}  // namespace
+
+TreeModeler::TreeModeler(const ModelerConfig& config) : config_(config) { config_.validate(); }
+
+ModelResult TreeModeler::model(const Cloud& cloud) const {
+  Points pts;
+  pts.reserve(cloud.size());
+  for (const auto& p : cloud.points) {
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) pts.emplace_back(p.x, p.y, p.z);
+  }
+  return model(pts);
+}
+
+ModelResult TreeModeler::model(const Points& input) const {
+  const auto start = std::chrono::steady_clock::now();
+  ModelResult result;
+  Stopwatch watch(result.timings);
+  std::size_t finite = 0;
+  for (const auto& p : input) finite += p.allFinite();
+  if (finite < MIN_POINTS) {
+    throw Error(ErrorCode::EMPTY_INPUT, "cloud has " + std::to_string(finite) + " finite points; at least " +
+                                            std::to_string(MIN_POINTS) + " are needed to model a tree");
+  }
+  Points clean;
+  clean.reserve(finite);
+  for (const auto& p : input) {
+    if (p.allFinite()) clean.push_back(p);
+  }
+  result.points = preprocess(clean, config_, &result.preprocess);
+  const Points& pts = result.points;
+  watch.lap("preprocess");
+  if (pts.size() < MIN_POINTS) {
+    throw Error(ErrorCode::EMPTY_INPUT, "only " + std::to_string(pts.size()) + " points left after preprocessing");
+  }
+
+  // Algorithm 2.
+  auto clusters = initialClusters(pts, config_);
+  watch.lap("kmeans");
+  result.split_error = config_.ours_derive_parameters ? derivedSplitError(clusters, config_.split_error)
+                                                      : config_.split_error;
+  clusters = splitClusters(pts, std::move(clusters), result.split_error, config_);
+  clusters = mergeClusters(pts, std::move(clusters), config_.merge_distance);
+  watch.lap("split_merge");
+  const auto adjacency = connectClusters(pts, clusters, config_);
+  const TrunkPath path = findTrunkPath(clusters, adjacency, config_);
+  watch.lap("graph");
+  result.clusters = static_cast<int>(clusters.size());
+  result.trunk_clusters = static_cast<int>(path.trunk.size());
+  result.primary_clusters = static_cast<int>(path.primary.size());
+
+  // Algorithm 3: the trunk region is the trunk and primary-branch clusters.
+  std::vector<int> region;
+  std::vector<Eigen::Vector3d> axis;
+  for (const int c : path.trunk) {
+    region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
+    axis.push_back(clusters[c].centroid);
+  }
+  if (path.trunk.size() == 1) {
+    const auto& c = clusters[path.trunk[0]];
+    if (!c.fit) throw Error(ErrorCode::NO_TRUNK, "no trunk: the lowest cluster is not cylindrical");
+    axis = {c.fit->center - 0.5 * c.fit->length * c.fit->axis, c.fit->center + 0.5 * c.fit->length * c.fit->axis};
+  }
+  for (const int c : path.primary) region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
+  std::sort(region.begin(), region.end());
+  std::vector<double> radii;
+  for (const int c : path.trunk) {
+    if (clusters[c].fit && clusters[c].fit->radius < 0.3) radii.push_back(clusters[c].fit->radius);
+  }
+  std::sort(radii.begin(), radii.end());
+  const double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
+  const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
+
+  result.noise_sigma = trunk.noise_sigma;
+  watch.lap("trunk");
+  const auto branches = modelBranches(pts, trunk, region, config_);
+  watch.lap("branches");
+
+  // Model, measurements and point classes.
+  TreeModel& model = result.model;
+  model.input_points = input.size();
+  result.classes.assign(pts.size(), PointClass::OTHER);
+  double base_z = 1e300;
+  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+    const Cylinder& c = trunk.cylinders[i];
+    base_z = std::min(base_z, (c.center - 0.5 * c.length * c.axis).z());
+    std::size_t inliers = 0, total = 0;
+    for (const int k : region) {
+      const double s = trunk.centerline.project(pts[k]);
+      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second) continue;
+      ++total;
+      if (std::abs(axisDistance(c, pts[k]) - c.radius) < std::max(config_.cylinder_threshold, 2.5 * trunk.noise_sigma)) {
+        ++inliers;
+        result.classes[k] = PointClass::TRUNK;
+      }
+    }
+    model.trunk.push_back(toModel(c, static_cast<int>(i), inliers, total));
+  }
+  const int first_branch_id = static_cast<int>(trunk.cylinders.size());
+  for (std::size_t b = 0; b < branches.size(); ++b) {
+    const BranchFit& f = branches[b];
+    PrimaryBranch pb;
+    pb.cylinder = toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(), f.inliers.size());
+    pb.trunk_segment = f.trunk_segment;
+    const Cylinder& seg = trunk.cylinders[f.trunk_segment];
+    pb.measurement.attachment_height = f.attachment.z() - base_z;
+    pb.measurement.angle_to_trunk = std::acos(std::clamp(f.cylinder.axis.dot(seg.axis), -1.0, 1.0));
+    pb.measurement.trunk_diameter = 2.0 * seg.radius;
+    pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
+    pb.measurement.prune = pb.measurement.diameter_ratio > config_.prune_ratio;
+    model.primary_branches.push_back(pb);
+    for (const int k : f.inliers) result.classes[k] = PointClass::PRIMARY;
+  }
+  model.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,48 @@
+// evaluate_model: scores models against ground truth as docs/evaluation.md defines.
+#include <boost/program_options.hpp>
+#include <iostream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/io/tree_json.h"
+
+namespace po = boost::program_options;
+using namespace dormant_tree_modeling;
+
+int main(int argc, char** argv) {
+  std::vector<std::string> models, truths;
+  po::options_description desc(
+      "Usage: evaluate_model --model model.json --truth truth.json [--model M2 --truth T2 ...] [--json]\n"
+      "Prints PB, IPB, FP rate, FN rate, F1, branch and trunk diameter MAE, coverage, runtime");
+  desc.add_options()("help,h", "this help")("model,m", po::value(&models)->composing(), "model JSON (repeatable)")(
+      "truth,t", po::value(&truths)->composing(), "truth JSON, paired in order with --model")(
+      "json", "machine-readable output");
+  try {
+    po::variables_map vm;
+    po::store(po::parse_command_line(argc, argv, desc), vm);
+    if (vm.count("help")) {
+      std::cout << desc << "\n";
+      return 0;
+    }
+    po::notify(vm);
+    if (models.empty() || models.size() != truths.size()) {
+      std::cerr << "evaluate_model: give as many --model as --truth (at least one pair)\n";
+      return 2;
+    }
+    std::vector<evaluation::TreeScore> scores;
+    for (std::size_t i = 0; i < models.size(); ++i) {
+      auto s = evaluation::evaluate(io::readModelFile(models[i]), io::readTruthFile(truths[i]));
+      s.name = models[i];
+      if (s.name.size() > 28) s.name = "..." + s.name.substr(s.name.size() - 25);
+      scores.push_back(s);
+    }
+    std::cout << (vm.count("json") ? evaluation::scoresToJson(scores) : evaluation::formatTable(scores));
+    return 0;
+  } catch (const po::error& e) {
+    std::cerr << "evaluate_model: " << e.what() << "\n";
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << "evaluate_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
+    return 3;
+  }
+}
