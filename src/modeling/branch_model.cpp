@@ -77,7 +77,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     if (c.segment < 0 || c.s < s_lo || c.s > s_hi) return;
     const double r = trunk.cylinders[c.segment].radius;
     if (c.distance <= r + threshold) return;  // on the trunk surface
-    if (config.ours_branch_shell && c.distance > r + config.branch_fit_length + 0.05) return;
+    // The shell starts away from the trunk: near its surface the noise of the trunk links
+    // every branch to every other.
+    if (config.ours_branch_shell &&
+        (c.distance < r + config.branch_inner_gap || c.distance > r + config.branch_fit_length + 0.05)) {
+      return;
+    }
     candidates.push_back(i);
     where.push_back(c);
   };
@@ -138,7 +143,9 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     if (config.ours_constrain_ransac) {
       if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle) continue;
       if (gap > seg.radius + config.branch_axis_gap) continue;
-      if (nearest_gap > SURFACE_CONTACT + threshold) continue;
+      const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
+      if (nearest_gap > SURFACE_CONTACT + reach) continue;
+
     }
     Points in;
     BranchFit fit;

@@ -36,7 +36,16 @@ void updateCluster(const Points& pts, Cluster& c) {
   Eigen::Vector3d centroid;
   const Eigen::Vector3d axis = principalAxis(sub, &centroid);
   c.centroid = centroid;
-  c.fit = sub.size() >= 6 ? fitCylinder(sub, axis.z() < 0 ? Eigen::Vector3d(-axis) : axis) : std::nullopt;
+  // A short piece of trunk has no clear principal direction: try the vertical as well and keep
+  // the better least-squares fit.
+  c.fit.reset();
+  if (sub.size() >= 6) {
+    for (const Eigen::Vector3d& guess : {Eigen::Vector3d(axis.z() < 0 ? -axis : axis), Eigen::Vector3d::UnitZ().eval()}) {
+      const auto fit = fitCylinder(sub, guess);
+      if (fit && (!c.fit || fit->mean_abs_error < c.fit->mean_abs_error)) c.fit = fit;
+    }
+  }
+
   c.error = c.fit ? c.fit->mean_abs_error : std::numeric_limits<double>::infinity();
 }
 
@@ -181,80 +190,84 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vect
 
 TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config) {
-  TrunkPath path;
   const int n = static_cast<int>(clusters.size());
-  if (n == 0) return path;
+  if (n == 0) return TrunkPath{};
+  const double psi_t = config.psi_t * DEG;
+  auto radius = [&](int c) { return clusters[c].fit ? clusters[c].fit->radius : 0.0; };
+  // Steps 5 and 6 from one start cluster.
+  auto walk = [&](int start) {
+    TrunkPath path;
+    std::vector<char> in_trunk(n, 0);
+    path.trunk.push_back(start);
+    in_trunk[start] = 1;
+    for (;;) {
+      const int cur = path.trunk.back();
+      // Reference radius: median of the last three trunk clusters with a fit.
+      std::vector<double> recent;
+      for (auto it = path.trunk.rbegin(); it != path.trunk.rend() && recent.size() < 3; ++it) {
+        if (radius(*it) > 0.0) recent.push_back(radius(*it));
+      }
+      std::sort(recent.begin(), recent.end());
+      const double r_ref = recent.empty() ? 0.0 : recent[recent.size() / 2];
+      int next = -1;
+      double best = std::numeric_limits<double>::infinity();
+      for (const int k : adjacency[cur]) {
+        if (in_trunk[k]) continue;
+        const double psi = angleToVertical(clusters[k].centroid - clusters[cur].centroid);
+        if (psi >= psi_t) continue;
+        double score = psi;
+        if (config.ours_follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
+          score = psi / psi_t + std::abs(std::log(radius(k) / r_ref));
+        }
+        if (score < best) {
+          best = score;
+          next = k;
+        }
+      }
+      if (next < 0) break;
+      path.trunk.push_back(next);
+      in_trunk[next] = 1;
+    }
+    std::vector<char> seen(n, 0);
+    for (const int t : path.trunk) {
+      for (const int k : adjacency[t]) {
+        if (!in_trunk[k] && !seen[k]) {
+          seen[k] = 1;
+          path.primary.push_back(k);
+        }
+      }
+    }
+    return path;
+  };
   double zmin = std::numeric_limits<double>::infinity();
-  int start = 0;
+  int lowest = 0;
   for (int c = 0; c < n; ++c) {
     if (clusters[c].centroid.z() < zmin) {
       zmin = clusters[c].centroid.z();
-      start = c;
+      lowest = c;
     }
   }
-  if (config.ours_follow_diameter) {
-    // The target stands in the middle of its crop; a post or a neighbour's low branch does not.
-    std::vector<double> xs, ys;
-    for (const auto& c : clusters) {
-      xs.push_back(c.centroid.x());
-      ys.push_back(c.centroid.y());
+  if (!config.ours_follow_diameter) return walk(lowest);
+  // Ours: every sizeable, near-vertical cylinder piece near the bottom is a candidate base (a
+  // post or a neighbour's low branch can be lower than the target's base); the one whose walk
+  // gathers the most tree - trunk and attached clusters - is the target's trunk.
+  TrunkPath best_path = walk(lowest);
+  std::size_t best_size = best_path.trunk.size() + best_path.primary.size();
+  for (int c = 0; c < n; ++c) {
+    const auto& fit = clusters[c].fit;
+    if (c == lowest || clusters[c].centroid.z() > zmin + 0.3 || adjacency[c].empty() ||
+        static_cast<int>(clusters[c].members.size()) < 2 * config.min_cluster_points || !fit ||
+        std::abs(fit->axis.z()) < std::cos(config.trunk_max_tilt * DEG)) {
+      continue;
     }
-    std::nth_element(xs.begin(), xs.begin() + n / 2, xs.end());
-    std::nth_element(ys.begin(), ys.begin() + n / 2, ys.end());
-    const Eigen::Vector2d middle(xs[n / 2], ys[n / 2]);
-    double best = std::numeric_limits<double>::infinity();
-    for (int c = 0; c < n; ++c) {
-      if (clusters[c].centroid.z() > zmin + 0.3 || adjacency[c].empty()) continue;
-      const double d = (clusters[c].centroid.head<2>() - middle).norm();
-      if (d < best) {
-        best = d;
-        start = c;
-      }
-    }
-  }
-  std::vector<char> in_trunk(n, 0);
-  path.trunk.push_back(start);
-  in_trunk[start] = 1;
-  const double psi_t = config.psi_t * DEG;
-  auto radius = [&](int c) { return clusters[c].fit ? clusters[c].fit->radius : 0.0; };
-  for (;;) {
-    const int cur = path.trunk.back();
-    // Reference radius: median of the last three trunk clusters with a fit.
-    std::vector<double> recent;
-    for (auto it = path.trunk.rbegin(); it != path.trunk.rend() && recent.size() < 3; ++it) {
-      if (radius(*it) > 0.0) recent.push_back(radius(*it));
-    }
-    std::sort(recent.begin(), recent.end());
-    const double r_ref = recent.empty() ? 0.0 : recent[recent.size() / 2];
-    int next = -1;
-    double best = std::numeric_limits<double>::infinity();
-    for (const int k : adjacency[cur]) {
-      if (in_trunk[k]) continue;
-      const double psi = angleToVertical(clusters[k].centroid - clusters[cur].centroid);
-      if (psi >= psi_t) continue;
-      double score = psi;
-      if (config.ours_follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
-        score = psi / psi_t + std::abs(std::log(radius(k) / r_ref));
-      }
-      if (score < best) {
-        best = score;
-        next = k;
-      }
-    }
-    if (next < 0) break;
-    path.trunk.push_back(next);
-    in_trunk[next] = 1;
-  }
-  std::vector<char> seen(n, 0);
-  for (const int t : path.trunk) {
-    for (const int k : adjacency[t]) {
-      if (!in_trunk[k] && !seen[k]) {
-        seen[k] = 1;
-        path.primary.push_back(k);
-      }
+    TrunkPath path = walk(c);
+    const std::size_t size = path.trunk.size() + path.primary.size();
+    if (size > best_size) {
+      best_size = size;
+      best_path = std::move(path);
     }
   }
-  return path;
+  return best_path;
 }
 
 }  // namespace modeling

@@ -64,6 +64,7 @@ const std::map<std::string, Setter>& setters() {
       {"radius_continuity", setter(&C::radius_continuity)},
       {"branch_max_radial_angle", setter(&C::branch_max_radial_angle)},
       {"branch_axis_gap", setter(&C::branch_axis_gap)},
+      {"branch_inner_gap", setter(&C::branch_inner_gap)},
       {"floating_radius", setter(&C::floating_radius)},
       {"floating_min_neighbors", setter(&C::floating_min_neighbors)},
       {"wire_min_length", setter(&C::wire_min_length)},
@@ -112,6 +113,8 @@ void ModelerConfig::validate() const {
   check("radius_continuity", radius_continuity, 0.01, 10.0);
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
   check("branch_axis_gap", branch_axis_gap, 0.0, 1.0);
+  check("branch_inner_gap", branch_inner_gap, 0.0, 1.0);
+
   check("floating_radius", floating_radius, 0.001, 0.5);
   check("floating_min_neighbors", floating_min_neighbors, 1, 1000);
   check("wire_min_length", wire_min_length, 0.1, 100.0);

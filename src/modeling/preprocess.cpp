@@ -15,7 +15,9 @@ namespace {
 
 constexpr double GROUND_BAND = 0.03;         // m above the ground plane removed with it
 constexpr double GROUND_MIN_EXTENT = 0.8;    // m: a plane smaller than this is not the ground
-constexpr double WIRE_BAND = 0.012;          // m around a wire line
+constexpr double WIRE_BAND = 0.025;          // m around a wire line: its noisy returns
+constexpr double WIRE_NEIGHBOURHOOD = 0.10;  // m, for the linearity test
+constexpr double WIRE_LINEARITY = 0.1;       // second / first eigenvalue below this: a line
 constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr int MAX_WIRES = 10;
@@ -81,24 +83,39 @@ double longestRun(std::vector<double>& t) {
 }
 
 std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
+  if (pts.size() < 100) return 0;
+  // Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
+  // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points.
+  const PointIndex index(pts);
+  const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);
+  std::vector<int> candidates;
+  for (std::size_t i = 0; i < pts.size(); i += stride) {
+    const auto nn = index.within(pts[i], WIRE_NEIGHBOURHOOD);
+    if (nn.size() < 8) continue;
+    Points local;
+    for (const int j : nn) local.push_back(pts[j]);
+    Eigen::Vector3d eig;
+    const Eigen::Vector3d dir = principalAxis(local, nullptr, &eig);
+    if (eig(1) < WIRE_LINEARITY * eig(2) && std::abs(dir.z()) < std::sin(WIRE_MAX_TILT)) {
+      candidates.push_back(static_cast<int>(i));
+    }
+  }
   std::size_t removed = 0;
   Rng rng(seed);
-  for (int wire = 0; wire < MAX_WIRES && pts.size() > 100; ++wire) {
-    const int n = static_cast<int>(pts.size());
-    // Score candidate lines on a sample, verify the best on all points.
-    std::vector<int> sample;
-    for (int i = 0; i < std::min(n, 4000); ++i) sample.push_back(rng.uniformInt(0, n - 1));
+  std::vector<char> drop(pts.size(), 0);
+  for (int wire = 0; wire < MAX_WIRES && candidates.size() >= 10; ++wire) {
+    const int n = static_cast<int>(candidates.size());
     Eigen::Vector3d best_o = Eigen::Vector3d::Zero(), best_d = Eigen::Vector3d::UnitX();
     std::size_t best_count = 0;
-    for (int it = 0; it < 400; ++it) {
-      const auto& a = pts[sample[rng.uniformInt(0, static_cast<int>(sample.size()) - 1)]];
-      const auto& b = pts[sample[rng.uniformInt(0, static_cast<int>(sample.size()) - 1)]];
+    for (int it = 0; it < 300; ++it) {
+      const Eigen::Vector3d& a = pts[candidates[rng.uniformInt(0, n - 1)]];
+      const Eigen::Vector3d& b = pts[candidates[rng.uniformInt(0, n - 1)]];
       Eigen::Vector3d d = b - a;
-      if (d.norm() < 0.5 * min_length) continue;
+      if (d.norm() < 0.3) continue;
       d.normalize();
       if (std::abs(d.z()) > std::sin(WIRE_MAX_TILT)) continue;
       std::size_t count = 0;
-      for (const int i : sample) {
+      for (const int i : candidates) {
         const Eigen::Vector3d w = pts[i] - a;
         count += (w - w.dot(d) * d).squaredNorm() < WIRE_BAND * WIRE_BAND;
       }
@@ -111,24 +128,32 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
     if (best_count < 5) break;
     std::vector<double> along;
     std::vector<int> inliers;
-    for (int i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < pts.size(); ++i) {
       const Eigen::Vector3d w = pts[i] - best_o;
       if ((w - w.dot(best_d) * best_d).squaredNorm() < WIRE_BAND * WIRE_BAND) {
-        inliers.push_back(i);
+        inliers.push_back(static_cast<int>(i));
         along.push_back(w.dot(best_d));
       }
     }
-    if (longestRun(along) < min_length) break;
-    std::vector<char> drop(n, 0);
-    for (const int i : inliers) drop[i] = 1;
-    Points kept;
-    kept.reserve(n - inliers.size());
-    for (int i = 0; i < n; ++i) {
-      if (!drop[i]) kept.push_back(pts[i]);
+    // Whatever the verdict, these candidates are settled.
+    std::vector<int> rest;
+    for (const int i : candidates) {
+      const Eigen::Vector3d w = pts[i] - best_o;
+      if ((w - w.dot(best_d) * best_d).squaredNorm() >= WIRE_BAND * WIRE_BAND) rest.push_back(i);
     }
-    removed += inliers.size();
-    pts.swap(kept);
+    candidates.swap(rest);
+    if (longestRun(along) < min_length) continue;
+    for (const int i : inliers) {
+      removed += !drop[i];
+      drop[i] = 1;
+    }
   }
+  Points kept;
+  kept.reserve(pts.size() - removed);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (!drop[i]) kept.push_back(pts[i]);
+  }
+  pts.swap(kept);
   return removed;
 }
 

@@ -4,12 +4,17 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
 namespace dormant_tree_modeling {
@@ -18,6 +23,7 @@ namespace modeling {
 namespace {
 
 constexpr std::size_t MIN_POINTS = 100;
+constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
 
 class Stopwatch {
  public:
@@ -43,6 +49,70 @@ CylinderModel toModel(const Cylinder& c, int id, std::size_t inliers, std::size_
   m.num_points = inliers;
   m.inlier_ratio = total > 0 ? static_cast<double>(inliers) / static_cast<double>(total) : 0.0;
   return m;
+}
+
+/// Range-noise guess from a cluster's cylinder-fit residuals: 1.4826 MAD x sqrt(3/2) (see
+/// estimateNoiseSigma). The slices refine it later.
+double noiseGuess(const Points& pts, const Cluster& cluster) {
+  std::vector<double> res;
+  for (const int i : cluster.members) res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
+  std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
+  const double med = res[res.size() / 2];
+  for (double& r : res) r = std::abs(r - med);
+  std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
+  return 1.4826 * res[res.size() / 2] * std::sqrt(1.5);
+}
+
+/// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder
+/// piece near the bottom, Algorithm 2's start among them) and keep the track with the most
+/// points around it between 5 and 35 cm from its axis: branches. A post has none, a
+/// neighbour's branch is no vertical cylinder.
+std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<Cluster>& clusters,
+                                           const TrunkPath& path, const ModelerConfig& config) {
+  double zmin = std::numeric_limits<double>::infinity();
+  for (const auto& c : clusters) zmin = std::min(zmin, c.centroid.z());
+  std::vector<int> candidates{path.trunk.front()};
+  for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
+    const auto& fit = clusters[c].fit;
+    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + 0.3 && fit && fit->radius < 0.3 &&
+        static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
+        std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0)) {
+      candidates.push_back(c);
+    }
+  }
+  // The target is the tree its crop centres on (the paper's hand crop, our scan assembler's
+  // isolation): a candidate's score fades with its distance from the cloud's horizontal centre.
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const auto& p : pts) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  const Eigen::Vector2d middle = 0.5 * (lo + hi);
+  const PointIndex index(pts);
+  std::optional<TrackedTrunk> best;
+  double best_score = -1.0;
+  for (const int c : candidates) {
+    if (!clusters[c].fit) continue;
+    const Cylinder& first = *clusters[c].fit;
+    const Eigen::Vector3d up = first.axis.z() < 0.0 ? Eigen::Vector3d(-first.axis) : first.axis;
+    const Eigen::Vector3d start = first.center - 0.5 * first.length * up;
+    const double threshold = std::max(0.5 * config.circle_threshold, 2.5 * noiseGuess(pts, clusters[c]));
+    TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
+    if (tracked.centers.size() < 3) continue;
+    double shell = 0.0;
+    for (std::size_t k = 0; k < tracked.centers.size(); k += 2) {
+      const double r = tracked.radii[k];
+      shell += index.countWithin(tracked.centers[k], r + 0.35, 1 << 20) -
+               index.countWithin(tracked.centers[k], r + 0.05, 1 << 20);
+    }
+    const double off_centre = (start.head<2>() - middle).norm() / CENTRE_PRIOR_SCALE;
+    const double score = shell * std::exp(-off_centre * off_centre);
+    if (score > best_score) {
+      best_score = score;
+      best = std::move(tracked);
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -114,8 +184,27 @@ ModelResult TreeModeler::model(const Points& input) const {
     if (clusters[c].fit && clusters[c].fit->radius < 0.3) radii.push_back(clusters[c].fit->radius);
   }
   std::sort(radii.begin(), radii.end());
-  const double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
+  double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
+  if (config_.ours_follow_diameter) {
+    if (const auto tracked = trackBestTrunk(pts, clusters, path, config_)) {
+      axis = tracked->centers;
+      std::vector<double> r = tracked->radii;
+      std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+      radius = r[r.size() / 2];
+      // The trunk region becomes every point near the tracked axis, not only the clusters
+      // Algorithm 2 linked.
+      const Centerline line(axis);
+      const double reach = std::max(3.0 * radius, radius + 0.05);
+      region.clear();
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        double d = 0.0;
+        const double s = line.project(pts[i], &d);
+        if (d <= reach && s >= -0.05 && s <= line.length() + 0.05) region.push_back(static_cast<int>(i));
+      }
+    }
+  }
   const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
+
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");

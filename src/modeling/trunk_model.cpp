@@ -3,9 +3,12 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -249,7 +252,86 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
 
 }  // namespace
 
-double estimateNoiseSigma(const Points& pts, const Centerline& line, const std::vector<Slice>& slices,
+TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
+                        const Eigen::Vector3d& direction, double radius, double threshold,
+                        const ModelerConfig& config, int max_misses) {
+  TrackedTrunk out;
+  const double h = config.slice_height;
+  Eigen::Vector3d c = start, t = direction.normalized();
+  double r = std::clamp(radius, MIN_TRUNK_RADIUS, MAX_TRUNK_RADIUS);
+  int misses = 0;
+  std::uint64_t stream = 0;
+  for (int step = 0; step < 400 && misses < max_misses; ++step) {
+    const Eigen::Vector3d predicted = c + h * t;
+    const double lateral = std::max(3.0 * r, r + 0.05);
+    const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
+    Points2 plane;
+    for (const int i : index.within(predicted, std::hypot(0.5 * h, lateral))) {
+      const Eigen::Vector3d w = pts[i] - predicted;
+      if (std::abs(w.dot(t)) <= 0.5 * h) plane.emplace_back(w.dot(u), w.dot(v));
+    }
+    CircleRansacOptions o;
+    o.threshold = threshold;
+    o.iterations = config.ransac_iterations;
+    o.min_radius = std::max(MIN_TRUNK_RADIUS, 0.6 * r);
+    o.max_radius = 1.25 * r;
+    o.seed = config.seed * 31337 + stream++;
+    std::vector<int> inliers;
+    std::optional<Circle> circle;
+    const double sigma = threshold / 2.5;
+    if (plane.size() < MIN_SLICE_POINTS) {
+      // nothing to fit
+    } else if (sigma < 0.2 * r) {
+      circle = ransacCircle(plane, o, &inliers);
+    } else {
+      // Noise comparable to the radius: a circle band would cover the whole disc. The disc's
+      // trimmed mean is its centre (views all around), its second moment r^2 + sigma^2.
+      Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+      const double window = r + 2.5 * sigma;
+      for (int round = 0; round < 4; ++round) {
+        Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+        inliers.clear();
+        for (std::size_t k = 0; k < plane.size(); ++k) {
+          if ((plane[k] - centre).norm() < window) {
+            sum += plane[k];
+            inliers.push_back(static_cast<int>(k));
+          }
+        }
+        if (inliers.empty()) break;
+        centre = sum / static_cast<double>(inliers.size());
+      }
+      double m2 = 0.0;
+      for (const int k : inliers) m2 += (plane[k] - centre).squaredNorm();
+      if (!inliers.empty()) {
+        const double est = std::sqrt(std::max(0.0, m2 / inliers.size() - sigma * sigma));
+        circle = Circle{centre, std::clamp(est, o.min_radius, o.max_radius)};
+      }
+    }
+
+    const bool ok = circle && inliers.size() >= MIN_SLICE_POINTS / 2 && circle->center.norm() < r + 0.02;
+    if (getenv("DTM_DEBUG_TRACK")) fprintf(stderr, "  step z=%.2f n=%zu r=%.3f circle=%d cr=%.3f inl=%zu off=%.3f\n", predicted.z(), plane.size(), r, circle ? 1 : 0, circle ? circle->radius : 0.0, inliers.size(), circle ? circle->center.norm() : 0.0);
+    if (!ok) {
+      ++misses;
+      c = predicted;
+      continue;
+    }
+    misses = 0;
+    const Eigen::Vector3d centre = predicted + circle->center.x() * u + circle->center.y() * v;
+    if (!out.centers.empty()) {
+      const Eigen::Vector3d step_dir = (centre - out.centers.back()).normalized();
+      // Smooth the direction: one slice's centre is noisy, the trunk bends slowly.
+      if (step_dir.allFinite() && step_dir.dot(t) > 0.5) t = (0.7 * t + 0.3 * step_dir).normalized();
+    }
+    r = 0.7 * r + 0.3 * circle->radius;
+    c = centre;
+    out.centers.push_back(centre);
+    out.radii.push_back(circle->radius);
+  }
+  return out;
+}
+
+double estimateNoiseSigma(
+const Points& pts, const Centerline& line, const std::vector<Slice>& slices,
                           double slice_height) {
   std::vector<double> residuals;
   for (const auto& sl : slices) {

@@ -48,9 +48,11 @@ struct TrunkPath {
 };
 
 /// @brief Step 5: from the start cluster follow, at each step, the edge with the smallest angle
-/// psi to the vertical while psi < psi_T (paper). With config.ours_follow_diameter the choice
-/// also weighs how well the next cluster's radius continues the trunk's, and the start is the
-/// low cluster nearest the cloud's horizontal centre (not merely the lowest).
+/// psi to the vertical while psi < psi_T (paper), starting at the lowest cluster. With
+/// config.ours_follow_diameter the choice also weighs how well the next cluster's radius
+/// continues the trunk's, and of the candidate bases near the bottom (sizeable, near-vertical
+/// cylinder pieces) the one whose walk gathers the most clusters wins: a post has no branches.
+
 /// Step 6: primary-branch clusters.
 TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config);

@@ -45,7 +45,9 @@ struct ModelerConfig {
   double trunk_max_tilt = 30.0;   ///< trunk cylinders' axes within this of vertical
   double radius_continuity = 0.35;  ///< a trunk segment's radius within this share of its neighbour's
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
-  double branch_axis_gap = 0.06;  ///< branch axis must pass this close to the trunk surface
+  double branch_axis_gap = 0.10;  ///< branch axis must pass this close to the trunk surface
+  double branch_inner_gap = 0.05;  ///< shell branch candidates start this far out from the trunk surface
+
   double floating_radius = 0.02;  ///< floating-pixel removal: neighbourhood radius
   int floating_min_neighbors = 4;  ///< fewer neighbours within the radius: a floating pixel
   double wire_min_length = 1.2;    ///< straight thin horizontal runs this long are wires

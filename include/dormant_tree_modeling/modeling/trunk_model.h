@@ -4,6 +4,7 @@
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -66,7 +67,24 @@ double estimateNoiseSigma(const Points& pts, const Centerline& line, const std::
 std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height,
                                           int zero_run, double top);
 
+/// @brief Result of trackTrunk().
+struct TrackedTrunk {
+  std::vector<Eigen::Vector3d> centers;  ///< accepted slice centres, bottom to top
+  std::vector<double> radii;             ///< raw circle radius at each centre
+};
+
+/// @brief Follow the trunk upwards slice by slice from a start (our alternative to Algorithm
+/// 2's path above its first clusters): predict the next centre along the current direction,
+/// fit a RANSAC circle there whose radius continues the trunk's (0.6x..1.25x: the leader is
+/// the thick continuation, a thin shoot is not), update centre, direction and radius, and stop
+/// after `max_misses` slices without an acceptable circle.
+/// @param index spatial index over pts
+TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
+                        const Eigen::Vector3d& direction, double radius, double threshold,
+                        const ModelerConfig& config, int max_misses = 4);
+
 /// @brief Algorithm 3 steps 1-4 on the trunk region.
+
 /// @param pts the modeled cloud
 /// @param region indices of trunk (and primary-cluster) points
 /// @param initial_axis initial centreline points, bottom to top (e.g. trunk cluster centroids;
