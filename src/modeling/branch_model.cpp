@@ -135,7 +135,9 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     o.max_radius = config.ours_constrain_ransac ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : 0.3;
     o.seed = config.seed * 15485863ULL + stream++;
     std::vector<int> inliers;
-    auto cyl = ransacCylinder(sub, axis, o, &inliers);
+    auto cyl = config.ours_constrain_ransac
+                   ? fitThinCylinder(sub, axis, sigma, o.max_radius, o.seed, &inliers)
+                   : ransacCylinder(sub, axis, o, &inliers);
     if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points) continue;
     if (cyl->axis.dot(radial) < 0.0) cyl->axis = -cyl->axis;
     Eigen::Vector3d attachment;
@@ -153,7 +155,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
       in.push_back(sub[i]);
       fit.inliers.push_back(sub_index[i]);
     }
-    if (config.ours_correct_noise_bias) {
+    if (config.ours_correct_noise_bias && !config.ours_constrain_ransac) {
+
       cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_BRANCH_RADIUS);
     }
     fit.cylinder = *cyl;

@@ -1,5 +1,6 @@
 #include <Eigen/Dense>
 #include <cmath>
+#include <map>
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/common/random.h"
@@ -178,6 +179,129 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
   if (n == 0) return c.radius;
   const double r2 = sum / n - sigma * sigma;
   return std::max(min_radius, std::sqrt(std::max(0.0, r2)));
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess, double sigma,
+                                        double max_radius, std::uint64_t seed, std::vector<int>* inliers) {
+  constexpr double MIN_RADIUS = 0.002;
+  const int n = static_cast<int>(pts.size());
+  if (n < 6) return std::nullopt;
+  const double band = max_radius + std::max(2.5 * sigma, 0.004);
+  auto lineInliers = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::vector<int>& out) {
+    out.clear();
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d w = pts[i] - o;
+      if ((w - w.dot(d) * d).squaredNorm() < band * band) out.push_back(i);
+    }
+  };
+  Rng rng(seed);
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero(), dir = axis_guess.normalized();
+  principalAxis(pts, &origin);
+  std::vector<int> best, in;
+  lineInliers(origin, dir, best);
+  for (int it = 0; it < 100; ++it) {
+    const Eigen::Vector3d& a = pts[rng.uniformInt(0, n - 1)];
+    const Eigen::Vector3d& b = pts[rng.uniformInt(0, n - 1)];
+    Eigen::Vector3d d = b - a;
+    if (d.norm() < 4.0 * band) continue;
+    d.normalize();
+    if (std::abs(d.dot(axis_guess.normalized())) < std::cos(M_PI / 3.0)) continue;
+    lineInliers(a, d, in);
+    if (in.size() > best.size()) {
+      best = in;
+      origin = a;
+      dir = d;
+    }
+  }
+  for (int round = 0; round < 2 && best.size() >= 6; ++round) {
+    Points sub;
+    for (const int i : best) sub.push_back(pts[i]);
+    const Eigen::Vector3d d = principalAxis(sub, &origin);
+    dir = d.dot(axis_guess) < 0.0 ? Eigen::Vector3d(-d) : d;
+    lineInliers(origin, dir, best);
+  }
+  if (best.size() < 6) return std::nullopt;
+  Cylinder cyl;
+  cyl.center = origin;
+  cyl.axis = dir;
+  // Robust re-centring: per 4 cm slice along the axis, the centroid of the points within
+  // radius + 2.5 sigma of the current axis (a full cross-section's centroid is its centre);
+  // a line through the slice centroids; the radius from the median of the slices' second
+  // moments less the noise. A parallel shoot or a spur moves a least-squares cylinder, not this.
+  constexpr double SLICE = 0.04;
+  std::vector<int> used;
+  double radius = max_radius;
+  for (int round = 0; round < 5; ++round) {
+    const double reach = radius + 2.5 * sigma + 0.002;
+    used.clear();
+    std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
+    for (const int i : best) {
+      if (axisDistance(cyl, pts[i]) >= reach) continue;
+      used.push_back(i);
+      const long key = static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE));
+      auto it = centroids.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
+      it->second.first += pts[i];
+      ++it->second.second;
+    }
+    if (used.size() < 6) return std::nullopt;
+    Points centres;
+    for (const auto& kv : centroids) {
+      if (kv.second.second >= 3) centres.push_back(kv.second.first / kv.second.second);
+    }
+    if (centres.size() >= 2) {
+      Eigen::Vector3d c;
+      Eigen::Vector3d d = principalAxis(centres, &c);
+      if (d.dot(axis_guess) < 0.0) d = -d;
+      if (d.dot(cyl.axis) > std::cos(30.0 * M_PI / 180.0)) {
+        cyl.center = c;
+        cyl.axis = d;
+      }
+    }
+    std::map<long, std::pair<double, int>> moments_by_slice;
+    for (const int i : used) {
+      const double dist = axisDistance(cyl, pts[i]);
+      if (dist >= reach) continue;
+      auto& m = moments_by_slice[static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))];
+      m.first += dist * dist;
+      ++m.second;
+    }
+    std::vector<double> moments;
+    double total = 0.0;
+    int total_n = 0;
+    for (const auto& kv : moments_by_slice) {
+      total += kv.second.first;
+      total_n += kv.second.second;
+      if (kv.second.second >= 6) moments.push_back(kv.second.first / kv.second.second);
+    }
+    if (total_n < 6) return std::nullopt;
+    double moment = total / total_n;
+    if (!moments.empty()) {
+      std::nth_element(moments.begin(), moments.begin() + moments.size() / 2, moments.end());
+      moment = moments[moments.size() / 2];
+    }
+    radius = std::clamp(std::sqrt(std::max(0.0, moment - sigma * sigma)), MIN_RADIUS, max_radius);
+  }
+  cyl.radius = radius;
+  const int count = static_cast<int>(used.size());
+  // Extent and error statistics over the points used.
+  double lo = 1e300, hi = -1e300, abs_err = 0.0;
+  for (const int i : used) {
+    const double t = (pts[i] - cyl.center).dot(cyl.axis);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+    abs_err += std::abs(axisDistance(cyl, pts[i]) - cyl.radius);
+  }
+  cyl.center += 0.5 * (lo + hi) * cyl.axis;
+  cyl.length = hi - lo;
+  cyl.mean_abs_error = abs_err / count;
+  if (inliers) *inliers = used;
+  return cyl;
 }
 
 }  // namespace modeling

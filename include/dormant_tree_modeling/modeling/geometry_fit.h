@@ -94,6 +94,14 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
 double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
                             double min_radius);
 
+/// @brief Cylinder for thin, noisy branches, where a RANSAC circle band would be wider than the
+/// radius: a RANSAC line (band: max_radius + 2.5 sigma) refined by PCA on its inliers, then a
+/// least-squares cylinder on them when it agrees with the line (within 20 deg, radius within
+/// bounds), and the radius from the noise-corrected second moment sqrt(mean d^2 - sigma^2).
+/// @param inliers set to the indices of the points used for the radius
+std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess, double sigma,
+                                        double max_radius, std::uint64_t seed, std::vector<int>* inliers = nullptr);
+
 /// @brief Deterministic k-means with k-means++ seeding from `seed`.
 /// @param pts points
 /// @param k clusters (clamped to the number of points)
