@@ -14,7 +14,8 @@ PolylinePoint closestPoint(const Polyline& line, const Eigen::Vector3d& q) {
   for (std::size_t i = 0; i + 1 < line.points.size(); ++i) {
     const Eigen::Vector3d a = line.points[i], ab = line.points[i + 1] - a;
     const double len = ab.norm();
-    if (len <= 0.0) continue;
+    if (len <= 0.0)
+      continue;
     const double t = std::clamp((q - a).dot(ab) / (len * len), 0.0, 1.0);
     const Eigen::Vector3d p = a + t * ab;
     const double d = (p - q).norm();
@@ -30,24 +31,30 @@ PolylinePoint closestPoint(const Polyline& line, const Eigen::Vector3d& q) {
   return best;
 }
 
-bool canMatch(const modeling::CylinderModel& detection, const Polyline& line, const MatchBounds& bounds, double* e,
-              PolylinePoint* at) {
+bool canMatch(const modeling::CylinderModel& detection, const Polyline& line,
+              const MatchBounds& bounds, double* e, PolylinePoint* at) {
   const PolylinePoint q = closestPoint(line, detection.center);
-  if (e) *e = q.distance;
-  if (at) *at = q;
-  const double angle = std::acos(std::min(1.0, std::abs(detection.axis.normalized().dot(q.direction))));
-  return q.distance <= std::max(bounds.min_distance, q.diameter) && q.arc_length <= bounds.max_arc_length &&
-         angle <= bounds.max_angle_deg * M_PI / 180.0;
+  if (e)
+    *e = q.distance;
+  if (at)
+    *at = q;
+  const double angle =
+      std::acos(std::min(1.0, std::abs(detection.axis.normalized().dot(q.direction))));
+  return q.distance <= std::max(bounds.min_distance, q.diameter) &&
+         q.arc_length <= bounds.max_arc_length && angle <= bounds.max_angle_deg * M_PI / 180.0;
 }
 
 std::vector<int> assign(const std::vector<std::vector<double>>& cost, double forbidden) {
   const int rows = static_cast<int>(cost.size());
   const int cols = rows > 0 ? static_cast<int>(cost[0].size()) : 0;
   std::vector<int> result(rows, -1);
-  if (rows == 0 || cols == 0) return result;
+  if (rows == 0 || cols == 0)
+    return result;
   // Square the problem (Kuhn-Munkres with potentials, O(n^3)); padding costs `forbidden`.
   const int n = std::max(rows, cols);
-  auto c = [&](int i, int j) { return i < rows && j < cols ? std::min(cost[i][j], forbidden) : forbidden; };
+  auto c = [&](int i, int j) {
+    return i < rows && j < cols ? std::min(cost[i][j], forbidden) : forbidden;
+  };
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> u(n + 1, 0.0), v(n + 1, 0.0);
   std::vector<int> p(n + 1, 0), way(n + 1, 0);
@@ -62,7 +69,8 @@ std::vector<int> assign(const std::vector<std::vector<double>>& cost, double for
       double delta = inf;
       int j1 = 0;
       for (int j = 1; j <= n; ++j) {
-        if (used[j]) continue;
+        if (used[j])
+          continue;
         const double cur = c(i0 - 1, j - 1) - u[i0] - v[j];
         if (cur < minv[j]) {
           minv[j] = cur;
@@ -91,12 +99,14 @@ std::vector<int> assign(const std::vector<std::vector<double>>& cost, double for
   }
   for (int j = 1; j <= n; ++j) {
     const int i = p[j] - 1, col = j - 1;
-    if (i < rows && col < cols && cost[i][col] < forbidden) result[i] = col;
+    if (i < rows && col < cols && cost[i][col] < forbidden)
+      result[i] = col;
   }
   return result;
 }
 
-TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, const MatchBounds& bounds) {
+TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
+                   const MatchBounds& bounds) {
   constexpr double FORBIDDEN = 1e9;
   TreeScore s;
   s.pb = static_cast<int>(truth.primary_branches.size());
@@ -119,7 +129,8 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, c
     if (assignment[d] >= 0) {
       PolylinePoint at;
       double e = 0.0;
-      canMatch(model.primary_branches[d].cylinder, truth.primary_branches[assignment[d]], bounds, &e, &at);
+      canMatch(model.primary_branches[d].cylinder, truth.primary_branches[assignment[d]], bounds,
+               &e, &at);
       BranchMatch m{d, assignment[d], e, model.primary_branches[d].cylinder.diameter, at.diameter};
       const double err = m.detected_diameter - m.true_diameter;
       s.branch_mae += std::abs(err);
@@ -130,7 +141,8 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, c
     }
     bool minor = false;
     if (!any_primary[d]) {
-      for (const auto& m : truth.minor_branches) minor = minor || canMatch(model.primary_branches[d].cylinder, m, bounds);
+      for (const auto& m : truth.minor_branches)
+        minor = minor || canMatch(model.primary_branches[d].cylinder, m, bounds);
     }
     if (minor) {
       ++s.ignored;
@@ -171,13 +183,16 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, c
   s.trunk_mae = weight > 0.0 ? weighted / weight : 0.0;
   s.centerline_error = centre_n > 0 ? centre_sum / centre_n : 0.0;
   double top = 0.0;
-  for (const auto& b : truth.primary_branches) top = std::max(top, closestPoint(truth.trunk, b.points.front()).arc_length);
-  if (top <= 0.0) top = closestPoint(truth.trunk, truth.trunk.points.back()).arc_length;
+  for (const auto& b : truth.primary_branches)
+    top = std::max(top, closestPoint(truth.trunk, b.points.front()).arc_length);
+  if (top <= 0.0)
+    top = closestPoint(truth.trunk, truth.trunk.points.back()).arc_length;
   std::sort(spans.begin(), spans.end());
   double covered = 0.0, reach = 0.0;
   for (const auto& sp : spans) {
     const double a = std::max(sp.first, reach), b = std::min(sp.second, top);
-    if (b > a) covered += b - a;
+    if (b > a)
+      covered += b - a;
     reach = std::max(reach, sp.second);
   }
   s.coverage = top > 0.0 ? std::min(1.0, covered / top) : 0.0;
@@ -187,7 +202,8 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, c
 TreeScore meanScore(const std::vector<TreeScore>& scores) {
   TreeScore m;
   m.name = "mean";
-  if (scores.empty()) return m;
+  if (scores.empty())
+    return m;
   const double n = static_cast<double>(scores.size());
   double pb = 0, ipb = 0;
   for (const auto& s : scores) {

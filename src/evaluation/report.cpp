@@ -40,16 +40,21 @@ nlohmann::json toJson(const TreeScore& s) {
 
 std::string formatTable(const std::vector<TreeScore>& scores) {
   std::string out =
-      "tree                           PB  IPB  FP rate  FN rate       F1  br MAE mm  tr MAE mm  cover  runtime s\n";
-  for (const auto& s : scores) out += row(s) + "\n";
-  if (scores.size() > 1) out += row(meanScore(scores)) + "\n";
+      "tree                           PB  IPB  FP rate  FN rate       F1  br MAE mm  tr MAE mm  "
+      "cover  runtime s\n";
+  for (const auto& s : scores)
+    out += row(s) + "\n";
+  if (scores.size() > 1)
+    out += row(meanScore(scores)) + "\n";
   return out;
 }
 
 std::string scoresToJson(const std::vector<TreeScore>& scores) {
-  if (scores.size() == 1) return toJson(scores[0]).dump(2) + "\n";
+  if (scores.size() == 1)
+    return toJson(scores[0]).dump(2) + "\n";
   nlohmann::json trees = nlohmann::json::array();
-  for (const auto& s : scores) trees.push_back(toJson(s));
+  for (const auto& s : scores)
+    trees.push_back(toJson(s));
   return nlohmann::json{{"trees", trees}, {"mean", toJson(meanScore(scores))}}.dump(2) + "\n";
 }
 

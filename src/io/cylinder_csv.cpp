@@ -8,12 +8,13 @@ namespace io {
 
 namespace {
 
-std::string common(const char* role, const modeling::CylinderModel& c, int parent, const Eigen::Vector3d& offset) {
+std::string common(const char* role, const modeling::CylinderModel& c, int parent,
+                   const Eigen::Vector3d& offset) {
   char buf[384];
   const Eigen::Vector3d p = c.center + offset;
-  std::snprintf(buf, sizeof(buf), "%s,%d,%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.5f,%.4f,%zu,%.3f", role, c.id, parent,
-                p.x(), p.y(), p.z(), c.axis.x(), c.axis.y(), c.axis.z(), c.diameter, c.length, c.num_points,
-                c.inlier_ratio);
+  std::snprintf(buf, sizeof(buf), "%s,%d,%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.5f,%.4f,%zu,%.3f", role,
+                c.id, parent, p.x(), p.y(), p.z(), c.axis.x(), c.axis.y(), c.axis.z(), c.diameter,
+                c.length, c.num_points, c.inlier_ratio);
   return buf;
 }
 
@@ -21,9 +22,11 @@ std::string common(const char* role, const modeling::CylinderModel& c, int paren
 
 std::string cylindersToCsv(const modeling::TreeModel& model, const Eigen::Vector3d& offset) {
   std::string out =
-      "role,id,parent_id,center_x,center_y,center_z,axis_x,axis_y,axis_z,diameter_m,length_m,num_points,"
+      "role,id,parent_id,center_x,center_y,center_z,axis_x,axis_y,axis_z,diameter_m,length_m,num_"
+      "points,"
       "inlier_ratio,attachment_height_m,angle_to_trunk_deg,trunk_diameter_m,diameter_ratio,prune\n";
-  for (const auto& c : model.trunk) out += common("trunk", c, -1, offset) + ",,,,,\n";
+  for (const auto& c : model.trunk)
+    out += common("trunk", c, -1, offset) + ",,,,,\n";
   for (const auto& b : model.primary_branches) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), ",%.4f,%.2f,%.5f,%.3f,%d\n", b.measurement.attachment_height,

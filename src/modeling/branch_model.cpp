@@ -13,7 +13,9 @@ namespace {
 
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
-constexpr double SURFACE_CONTACT = 0.05;  // m: a branch's nearest points lie this close to the trunk
+constexpr double SURFACE_CONTACT = 0.05;
+constexpr int MAX_EXTRACTIONS = 400;  // re-clustered remainders per tree, a bound on the work  //
+                                      // m: a branch's nearest points lie this close to the trunk
 
 /// Where a point sits relative to the trunk model.
 struct TrunkCoords {
@@ -34,7 +36,8 @@ TrunkCoords locate(const TrunkModel& trunk, const Eigen::Vector3d& p) {
       c.segment = static_cast<int>(i);
     }
   }
-  if (c.segment >= 0) c.distance = axisDistance(trunk.cylinders[c.segment], p);
+  if (c.segment >= 0)
+    c.distance = axisDistance(trunk.cylinders[c.segment], p);
   return c;
 }
 
@@ -53,19 +56,24 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
     s = e / c;
   }
   const Eigen::Vector3d x = p + t * u, y = q + s * v;
-  if (on_second) *on_second = y;
+  if (on_second)
+    *on_second = y;
   return (x - y).norm();
 }
 
 }  // namespace
 
-std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk, const std::vector<int>& region,
-                                     const ModelerConfig& config) {
+std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
+                                     const std::vector<int>& region, const ModelerConfig& config) {
   std::vector<BranchFit> branches;
-  if (trunk.cylinders.empty()) return branches;
+  if (trunk.cylinders.empty())
+    return branches;
+  // Bands follow the range noise; radii lose the noise and the beam's lateral scatter.
   const double sigma = trunk.noise_sigma;
+  const double scatter = config.ours_correct_noise_bias ? trunk.scatter : 0.0;
   double threshold = config.cylinder_threshold;
-  if (config.ours_derive_parameters) threshold = std::max(threshold, 2.5 * sigma);
+  if (config.ours_derive_parameters)
+    threshold = std::max(threshold, 2.5 * sigma);
   const double s_lo = trunk.cylinder_ranges.front().first - 0.05;
   const double s_hi = trunk.cylinder_ranges.back().second + 0.05;
 
@@ -74,29 +82,41 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
   std::vector<TrunkCoords> where;
   auto consider = [&](int i) {
     const TrunkCoords c = locate(trunk, pts[i]);
-    if (c.segment < 0 || c.s < s_lo || c.s > s_hi) return;
+    if (c.segment < 0 || c.s < s_lo || c.s > s_hi)
+      return;
     const double r = trunk.cylinders[c.segment].radius;
-    if (c.distance <= r + threshold) return;  // on the trunk surface
+    if (c.distance <= r + threshold)
+      return;  // on the trunk surface
     // The shell starts away from the trunk: near its surface the noise of the trunk links
     // every branch to every other.
-    if (config.ours_branch_shell &&
-        (c.distance < r + config.branch_inner_gap || c.distance > r + config.branch_fit_length + 0.05)) {
+    if (config.ours_branch_shell && (c.distance < r + config.branch_inner_gap ||
+                                     c.distance > r + config.branch_fit_length + 0.05)) {
       return;
     }
     candidates.push_back(i);
     where.push_back(c);
   };
   if (config.ours_branch_shell) {
-    for (std::size_t i = 0; i < pts.size(); ++i) consider(static_cast<int>(i));
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      consider(static_cast<int>(i));
   } else {
-    for (const int i : region) consider(i);
+    for (const int i : region)
+      consider(i);
   }
   Points cand_pts;
-  for (const int i : candidates) cand_pts.push_back(pts[i]);
-  const auto clusters = euclideanClusters(cand_pts, config.branch_cluster_tolerance, config.branch_min_points);
+  for (const int i : candidates)
+    cand_pts.push_back(pts[i]);
+  const auto clusters =
+      euclideanClusters(cand_pts, config.branch_cluster_tolerance, config.branch_min_points);
 
   std::uint64_t stream = 0;
-  for (const auto& cluster : clusters) {
+  // Work list: clusters, and what is left of a cluster after a branch was taken out of it (two
+  // branches, or a branch and a shoot, close enough to form one cluster).
+  std::vector<std::vector<int>> work(clusters.rbegin(), clusters.rend());
+  int extractions = 0;
+  while (!work.empty()) {
+    const std::vector<int> cluster = std::move(work.back());
+    work.pop_back();
     // The part of the branch near the trunk: where diameters are measured and pruning cuts.
     Points sub;
     std::vector<int> sub_index;
@@ -116,16 +136,22 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         sub_index.push_back(candidates[k]);
       }
     }
-    if (static_cast<int>(sub.size()) < config.branch_min_points) continue;
+    if (static_cast<int>(sub.size()) < config.branch_min_points)
+      continue;
     const Cylinder& seg = trunk.cylinders[segment];
     Eigen::Vector3d centroid;
     Eigen::Vector3d axis = principalAxis(sub, &centroid);
-    Eigen::Vector3d radial = (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
-    if (radial.norm() < 1e-9) continue;
+    Eigen::Vector3d radial =
+        (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
+    if (radial.norm() < 1e-9)
+      continue;
     radial.normalize();
-    if (axis.dot(radial) < 0.0) axis = -axis;
+    if (axis.dot(radial) < 0.0)
+      axis = -axis;
     const double max_angle = config.branch_max_radial_angle * DEG;
-    if (config.ours_constrain_ransac && std::acos(std::clamp(axis.dot(radial), -1.0, 1.0)) > max_angle) axis = radial;
+    if (config.ours_constrain_ransac &&
+        std::acos(std::clamp(axis.dot(radial), -1.0, 1.0)) > max_angle)
+      axis = radial;
     CylinderRansacOptions o;
     o.threshold = threshold;
     o.circle_iterations = config.ransac_iterations / 2;
@@ -136,18 +162,22 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     o.seed = config.seed * 15485863ULL + stream++;
     std::vector<int> inliers;
     auto cyl = config.ours_constrain_ransac
-                   ? fitThinCylinder(sub, axis, sigma, o.max_radius, o.seed, &inliers)
+                   ? fitThinCylinder(sub, axis, sigma, scatter, o.max_radius, o.seed, &inliers)
                    : ransacCylinder(sub, axis, o, &inliers);
-    if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points) continue;
-    if (cyl->axis.dot(radial) < 0.0) cyl->axis = -cyl->axis;
+    if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points)
+      continue;
+    if (cyl->axis.dot(radial) < 0.0)
+      cyl->axis = -cyl->axis;
     Eigen::Vector3d attachment;
     const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
     if (config.ours_constrain_ransac) {
-      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle) continue;
-      if (gap > seg.radius + config.branch_axis_gap) continue;
+      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle)
+        continue;
+      if (gap > seg.radius + config.branch_axis_gap)
+        continue;
       const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
-      if (nearest_gap > SURFACE_CONTACT + reach) continue;
-
+      if (nearest_gap > SURFACE_CONTACT + reach)
+        continue;
     }
     Points in;
     BranchFit fit;
@@ -156,21 +186,44 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
       fit.inliers.push_back(sub_index[i]);
     }
     if (config.ours_correct_noise_bias && !config.ours_constrain_ransac) {
-
       cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_BRANCH_RADIUS);
     }
     fit.cylinder = *cyl;
     fit.trunk_segment = segment;
     fit.attachment = attachment;
     branches.push_back(std::move(fit));
+    if (config.ours_constrain_ransac && extractions < MAX_EXTRACTIONS) {
+      // Take this branch's points out and look again at what remains of the cluster.
+      const double reach = cyl->radius + 2.5 * std::max(sigma, scatter) + 0.005;
+      Points rest_pts;
+      std::vector<int> rest;
+      for (const int k : cluster) {
+        if (axisDistance(*cyl, cand_pts[k]) > reach) {
+          rest.push_back(k);
+          rest_pts.push_back(cand_pts[k]);
+        }
+      }
+      if (static_cast<int>(rest.size()) >= 2 * config.branch_min_points) {
+        for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
+                                                  config.branch_min_points)) {
+          std::vector<int> mapped;
+          for (const int k : part)
+            mapped.push_back(rest[k]);
+          work.push_back(std::move(mapped));
+          ++extractions;
+        }
+      }
+    }
   }
   if (config.ours_constrain_ransac) {
     // One branch split into two clusters (a gap in its returns) appears twice: keep the larger.
     std::vector<char> drop(branches.size(), 0);
     for (std::size_t i = 0; i < branches.size(); ++i) {
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
-        if (drop[i] || drop[k]) continue;
-        const double angle = std::acos(std::clamp(branches[i].cylinder.axis.dot(branches[k].cylinder.axis), -1.0, 1.0));
+        if (drop[i] || drop[k])
+          continue;
+        const double angle = std::acos(
+            std::clamp(branches[i].cylinder.axis.dot(branches[k].cylinder.axis), -1.0, 1.0));
         if ((branches[i].attachment - branches[k].attachment).norm() < 0.06 && angle < 25.0 * DEG) {
           drop[branches[i].inliers.size() >= branches[k].inliers.size() ? k : i] = 1;
         }
@@ -178,7 +231,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     }
     std::vector<BranchFit> kept;
     for (std::size_t i = 0; i < branches.size(); ++i) {
-      if (!drop[i]) kept.push_back(std::move(branches[i]));
+      if (!drop[i])
+        kept.push_back(std::move(branches[i]));
     }
     branches.swap(kept);
   }

@@ -19,7 +19,8 @@ double Centerline::project(const Eigen::Vector3d& p, double* distance) const {
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const Eigen::Vector3d ab = vertices_[i + 1] - vertices_[i];
     const double len2 = ab.squaredNorm();
-    if (len2 <= 0.0) continue;
+    if (len2 <= 0.0)
+      continue;
     double t = (p - vertices_[i]).dot(ab) / len2;
     // Beyond the first and last vertex the end segments extend the line.
     const double lo = i == 0 ? -std::numeric_limits<double>::infinity() : 0.0;
@@ -31,13 +32,15 @@ double Centerline::project(const Eigen::Vector3d& p, double* distance) const {
       best_s = cumulative_[i] + t * std::sqrt(len2);
     }
   }
-  if (distance) *distance = best_d;
+  if (distance)
+    *distance = best_d;
   return best_s;
 }
 
 std::size_t Centerline::segmentAt(double s) const {
   const auto it = std::upper_bound(cumulative_.begin(), cumulative_.end(), s);
-  const std::size_t i = it == cumulative_.begin() ? 0 : static_cast<std::size_t>(it - cumulative_.begin()) - 1;
+  const std::size_t i =
+      it == cumulative_.begin() ? 0 : static_cast<std::size_t>(it - cumulative_.begin()) - 1;
   return std::min(i, vertices_.size() - 2);
 }
 

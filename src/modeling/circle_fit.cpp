@@ -1,30 +1,35 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
 
 std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                                     const Eigen::Vector2d& c) {
-  const double d = 2.0 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
+  const double d =
+      2.0 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
   const double scale = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), 1e-30});
-  if (std::abs(d) < 1e-9 * scale) return std::nullopt;
+  if (std::abs(d) < 1e-9 * scale)
+    return std::nullopt;
   const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
   Circle circle;
-  circle.center = Eigen::Vector2d((a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d,
-                                  (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d);
+  circle.center =
+      Eigen::Vector2d((a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d,
+                      (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d);
   circle.radius = (a - circle.center).norm();
   return circle;
 }
 
 std::optional<Circle> fitCircle(const Points2& pts) {
   const int n = static_cast<int>(pts.size());
-  if (n < 3) return std::nullopt;
+  if (n < 3)
+    return std::nullopt;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pts) mean += p;
+  for (const auto& p : pts)
+    mean += p;
   mean /= n;
   // Kasa: x^2 + y^2 + D x + E y + F = 0, linear least squares (centred for conditioning).
   Eigen::MatrixXd A(n, 3);
@@ -40,7 +45,8 @@ std::optional<Circle> fitCircle(const Points2& pts) {
   Circle c;
   c.center = Eigen::Vector2d(-0.5 * s(0), -0.5 * s(1));
   const double r2 = c.center.squaredNorm() - s(2);
-  if (!(r2 > 0.0) || !std::isfinite(r2)) return std::nullopt;
+  if (!(r2 > 0.0) || !std::isfinite(r2))
+    return std::nullopt;
   c.radius = std::sqrt(r2);
   // Geometric refinement: minimise sum (|q - c| - r)^2.
   for (int it = 0; it < 20; ++it) {
@@ -49,18 +55,22 @@ std::optional<Circle> fitCircle(const Points2& pts) {
     for (const auto& p : pts) {
       const Eigen::Vector2d q = p - mean - c.center;
       const double d = q.norm();
-      if (d < 1e-12) continue;
+      if (d < 1e-12)
+        continue;
       const Eigen::Vector3d J(-q.x() / d, -q.y() / d, -1.0);
       JtJ += J * J.transpose();
       Jtr += J * (d - c.radius);
     }
     const Eigen::Vector3d step = JtJ.ldlt().solve(-Jtr);
-    if (!step.allFinite()) break;
+    if (!step.allFinite())
+      break;
     c.center += step.head<2>();
     c.radius += step(2);
-    if (step.norm() < 1e-10) break;
+    if (step.norm() < 1e-10)
+      break;
   }
-  if (!(c.radius > 0.0) || !c.center.allFinite()) return std::nullopt;
+  if (!(c.radius > 0.0) || !c.center.allFinite())
+    return std::nullopt;
   c.center += mean;
   return c;
 }
@@ -68,16 +78,20 @@ std::optional<Circle> fitCircle(const Points2& pts) {
 std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions& o,
                                    std::vector<int>* inliers) {
   const int n = static_cast<int>(pts.size());
-  if (n < 3) return std::nullopt;
+  if (n < 3)
+    return std::nullopt;
   Rng rng(o.seed);
   std::optional<Circle> best;
   int best_count = 0;
   double best_cost = 0.0;
   for (int it = 0; it < o.iterations; ++it) {
-    const int i = rng.uniformInt(0, n - 1), j = rng.uniformInt(0, n - 1), k = rng.uniformInt(0, n - 1);
-    if (i == j || j == k || i == k) continue;
+    const int i = rng.uniformInt(0, n - 1), j = rng.uniformInt(0, n - 1),
+              k = rng.uniformInt(0, n - 1);
+    if (i == j || j == k || i == k)
+      continue;
     const auto c = circleThrough(pts[i], pts[j], pts[k]);
-    if (!c || c->radius < o.min_radius || c->radius > o.max_radius) continue;
+    if (!c || c->radius < o.min_radius || c->radius > o.max_radius)
+      continue;
     int count = 0;
     double cost = 0.0;
     for (const auto& p : pts) {
@@ -93,21 +107,25 @@ std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions
       best_cost = cost;
     }
   }
-  if (!best) return std::nullopt;
+  if (!best)
+    return std::nullopt;
   // Refine on the inliers, twice (inliers of the refined circle), within the radius bounds.
   for (int round = 0; round < 2; ++round) {
     Points2 sub;
     for (const auto& p : pts) {
-      if (std::abs((p - best->center).norm() - best->radius) < o.threshold) sub.push_back(p);
+      if (std::abs((p - best->center).norm() - best->radius) < o.threshold)
+        sub.push_back(p);
     }
     const auto refined = fitCircle(sub);
-    if (!refined || refined->radius < o.min_radius || refined->radius > o.max_radius) break;
+    if (!refined || refined->radius < o.min_radius || refined->radius > o.max_radius)
+      break;
     best = refined;
   }
   if (inliers) {
     inliers->clear();
     for (int i = 0; i < n; ++i) {
-      if (std::abs((pts[i] - best->center).norm() - best->radius) < o.threshold) inliers->push_back(i);
+      if (std::abs((pts[i] - best->center).norm() - best->radius) < o.threshold)
+        inliers->push_back(i);
     }
   }
   return best;

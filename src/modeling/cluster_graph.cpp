@@ -1,10 +1,10 @@
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
 
 #include <algorithm>
-#include <functional>
-#include <memory>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 #include "dormant_tree_modeling/modeling/point_index.h"
@@ -21,7 +21,8 @@ constexpr double LINK_MARGIN = 0.02;  // m: clusters whose boxes are farther apa
 Points gather(const Points& pts, const std::vector<int>& idx) {
   Points out;
   out.reserve(idx.size());
-  for (const int i : idx) out.push_back(pts[i]);
+  for (const int i : idx)
+    out.push_back(pts[i]);
   return out;
 }
 
@@ -40,9 +41,11 @@ void updateCluster(const Points& pts, Cluster& c) {
   // the better least-squares fit.
   c.fit.reset();
   if (sub.size() >= 6) {
-    for (const Eigen::Vector3d& guess : {Eigen::Vector3d(axis.z() < 0 ? -axis : axis), Eigen::Vector3d::UnitZ().eval()}) {
+    for (const Eigen::Vector3d& guess :
+         {Eigen::Vector3d(axis.z() < 0 ? -axis : axis), Eigen::Vector3d::UnitZ().eval()}) {
       const auto fit = fitCylinder(sub, guess);
-      if (fit && (!c.fit || fit->mean_abs_error < c.fit->mean_abs_error)) c.fit = fit;
+      if (fit && (!c.fit || fit->mean_abs_error < c.fit->mean_abs_error))
+        c.fit = fit;
     }
   }
 
@@ -50,22 +53,28 @@ void updateCluster(const Points& pts, Cluster& c) {
 }
 
 std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config) {
-  const int k = std::max(1, static_cast<int>(pts.size() / static_cast<std::size_t>(config.cluster_points)));
+  const int k =
+      std::max(1, static_cast<int>(pts.size() / static_cast<std::size_t>(config.cluster_points)));
   const auto labels = kMeans(pts, k, config.kmeans_iterations, config.seed);
   int count = 0;
-  for (const int l : labels) count = std::max(count, l + 1);
+  for (const int l : labels)
+    count = std::max(count, l + 1);
   std::vector<Cluster> clusters(count);
-  for (std::size_t i = 0; i < labels.size(); ++i) clusters[labels[i]].members.push_back(static_cast<int>(i));
-  for (auto& c : clusters) updateCluster(pts, c);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    clusters[labels[i]].members.push_back(static_cast<int>(i));
+  for (auto& c : clusters)
+    updateCluster(pts, c);
   return clusters;
 }
 
 double derivedSplitError(const std::vector<Cluster>& clusters, double configured) {
   std::vector<double> errors;
   for (const auto& c : clusters) {
-    if (std::isfinite(c.error)) errors.push_back(c.error);
+    if (std::isfinite(c.error))
+      errors.push_back(c.error);
   }
-  if (errors.empty()) return configured;
+  if (errors.empty())
+    return configured;
   const std::size_t q = errors.size() / 4;
   std::nth_element(errors.begin(), errors.begin() + q, errors.end());
   return std::max(configured, 1.5 * errors[q]);
@@ -79,13 +88,16 @@ std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clust
     Cluster c = std::move(clusters.back());
     clusters.pop_back();
     const bool small = static_cast<int>(c.members.size()) < 2 * config.min_cluster_points;
-    if (c.error <= e_t || small || static_cast<int>(done.size() + clusters.size()) >= MAX_CLUSTERS) {
+    if (c.error <= e_t || small ||
+        static_cast<int>(done.size() + clusters.size()) >= MAX_CLUSTERS) {
       done.push_back(std::move(c));
       continue;
     }
-    const auto labels = kMeans(gather(pts, c.members), 2, config.kmeans_iterations, config.seed + 101 + stream++);
+    const auto labels =
+        kMeans(gather(pts, c.members), 2, config.kmeans_iterations, config.seed + 101 + stream++);
     Cluster halves[2];
-    for (std::size_t i = 0; i < labels.size(); ++i) halves[labels[i]].members.push_back(c.members[i]);
+    for (std::size_t i = 0; i < labels.size(); ++i)
+      halves[labels[i]].members.push_back(c.members[i]);
     if (halves[1].members.empty()) {
       done.push_back(std::move(c));
       continue;
@@ -104,7 +116,9 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
     const int n = static_cast<int>(clusters.size());
     std::vector<int> parent(n);
     std::iota(parent.begin(), parent.end(), 0);
-    std::function<int(int)> find = [&](int i) { return parent[i] == i ? i : parent[i] = find(parent[i]); };
+    std::function<int(int)> find = [&](int i) {
+      return parent[i] == i ? i : parent[i] = find(parent[i]);
+    };
     for (int i = 0; i < n; ++i) {
       for (int k = i + 1; k < n; ++k) {
         if ((clusters[i].centroid - clusters[k].centroid).norm() < d_t && find(i) != find(k)) {
@@ -113,7 +127,8 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
         }
       }
     }
-    if (!merged) break;
+    if (!merged)
+      break;
     std::vector<Cluster> next;
     std::vector<int> slot(n, -1);
     for (int i = 0; i < n; ++i) {
@@ -134,7 +149,8 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
   return clusters;
 }
 
-std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vector<Cluster>& clusters,
+std::vector<std::vector<int>> connectClusters(const Points& pts,
+                                              const std::vector<Cluster>& clusters,
                                               const ModelerConfig& config) {
   const int n = static_cast<int>(clusters.size());
   std::vector<int> owner(pts.size(), -1);
@@ -157,7 +173,9 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vect
     int best_point = -1;
     for (const int i : clusters[from].members) {
       const Eigen::Vector3d& p = pts[i];
-      if (((p.array() < lo[to].array() - LINK_MARGIN) || (p.array() > hi[to].array() + LINK_MARGIN)).any()) continue;
+      if (((p.array() < lo[to].array() - LINK_MARGIN) || (p.array() > hi[to].array() + LINK_MARGIN))
+              .any())
+        continue;
       const auto nn = index[to]->nearest(p, 1);
       const double d = (pts[clusters[to].members[nn[0]]] - p).squaredNorm();
       if (d < best) {
@@ -165,22 +183,28 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vect
         best_point = i;
       }
     }
-    if (best_point < 0) return 0.0;
+    if (best_point < 0)
+      return 0.0;
     const auto nn = all.nearest(pts[best_point], config.graph_neighbors);
     int inside = 0;
-    for (const int j : nn) inside += owner[j] == to;
+    for (const int j : nn)
+      inside += owner[j] == to;
     return static_cast<double>(inside) / static_cast<double>(nn.size());
   };
   std::vector<std::vector<int>> adjacency(n);
   for (int i = 0; i < n; ++i) {
     for (int k = i + 1; k < n; ++k) {
-      if (((lo[i].array() > hi[k].array() + LINK_MARGIN) || (lo[k].array() > hi[i].array() + LINK_MARGIN)).any()) {
+      if (((lo[i].array() > hi[k].array() + LINK_MARGIN) ||
+           (lo[k].array() > hi[i].array() + LINK_MARGIN))
+              .any()) {
         continue;
       }
       const double a = share(i, k);
-      if (a < config.n_low || a > config.n_high) continue;
+      if (a < config.n_low || a > config.n_high)
+        continue;
       const double b = share(k, i);
-      if (b < config.n_low || b > config.n_high) continue;
+      if (b < config.n_low || b > config.n_high)
+        continue;
       adjacency[i].push_back(k);
       adjacency[k].push_back(i);
     }
@@ -188,10 +212,12 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vect
   return adjacency;
 }
 
-TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
+TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
+                        const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config) {
   const int n = static_cast<int>(clusters.size());
-  if (n == 0) return TrunkPath{};
+  if (n == 0)
+    return TrunkPath{};
   const double psi_t = config.psi_t * DEG;
   auto radius = [&](int c) { return clusters[c].fit ? clusters[c].fit->radius : 0.0; };
   // Steps 5 and 6 from one start cluster.
@@ -205,16 +231,19 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<
       // Reference radius: median of the last three trunk clusters with a fit.
       std::vector<double> recent;
       for (auto it = path.trunk.rbegin(); it != path.trunk.rend() && recent.size() < 3; ++it) {
-        if (radius(*it) > 0.0) recent.push_back(radius(*it));
+        if (radius(*it) > 0.0)
+          recent.push_back(radius(*it));
       }
       std::sort(recent.begin(), recent.end());
       const double r_ref = recent.empty() ? 0.0 : recent[recent.size() / 2];
       int next = -1;
       double best = std::numeric_limits<double>::infinity();
       for (const int k : adjacency[cur]) {
-        if (in_trunk[k]) continue;
+        if (in_trunk[k])
+          continue;
         const double psi = angleToVertical(clusters[k].centroid - clusters[cur].centroid);
-        if (psi >= psi_t) continue;
+        if (psi >= psi_t)
+          continue;
         double score = psi;
         if (config.ours_follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
           score = psi / psi_t + std::abs(std::log(radius(k) / r_ref));
@@ -224,7 +253,8 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<
           next = k;
         }
       }
-      if (next < 0) break;
+      if (next < 0)
+        break;
       path.trunk.push_back(next);
       in_trunk[next] = 1;
     }
@@ -247,7 +277,8 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<
       lowest = c;
     }
   }
-  if (!config.ours_follow_diameter) return walk(lowest);
+  if (!config.ours_follow_diameter)
+    return walk(lowest);
   // Ours: every sizeable, near-vertical cylinder piece near the bottom is a candidate base (a
   // post or a neighbour's low branch can be lower than the target's base); the one whose walk
   // gathers the most tree - trunk and attached clusters - is the target's trunk.

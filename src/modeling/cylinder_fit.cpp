@@ -2,8 +2,8 @@
 #include <cmath>
 #include <map>
 
-#include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -42,32 +42,42 @@ double axisDistance(const Cylinder& c, const Eigen::Vector3d& p) {
   return (w - w.dot(c.axis) * c.axis).norm();
 }
 
-Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid, Eigen::Vector3d* eigenvalues) {
+Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid,
+                              Eigen::Vector3d* eigenvalues) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : pts) mean += p;
+  for (const auto& p : pts)
+    mean += p;
   mean /= static_cast<double>(std::max<std::size_t>(1, pts.size()));
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
+  for (const auto& p : pts)
+    cov += (p - mean) * (p - mean).transpose();
   cov /= static_cast<double>(std::max<std::size_t>(1, pts.size()));
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-  if (centroid) *centroid = mean;
-  if (eigenvalues) *eigenvalues = es.eigenvalues();
+  if (centroid)
+    *centroid = mean;
+  if (eigenvalues)
+    *eigenvalues = es.eigenvalues();
   return es.eigenvectors().col(2);
 }
 
-std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& axis_guess, bool fixed_axis) {
-  if (pts.size() < 6) return std::nullopt;
+std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                    bool fixed_axis) {
+  if (pts.size() < 6)
+    return std::nullopt;
   Eigen::Vector3d a = axis_guess.normalized();
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : pts) mean += p;
+  for (const auto& p : pts)
+    mean += p;
   mean /= static_cast<double>(pts.size());
   Eigen::Vector3d u, v;
   basis(a, u, v);
   Points2 plane;
   plane.reserve(pts.size());
-  for (const auto& p : pts) plane.emplace_back((p - mean).dot(u), (p - mean).dot(v));
+  for (const auto& p : pts)
+    plane.emplace_back((p - mean).dot(u), (p - mean).dot(v));
   const auto circle = fitCircle(plane);
-  if (!circle) return std::nullopt;
+  if (!circle)
+    return std::nullopt;
   Eigen::Vector3d c = mean + circle->center.x() * u + circle->center.y() * v;
   double r = circle->radius;
   if (!fixed_axis) {
@@ -81,7 +91,8 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
         const double t = w.dot(a);
         const Eigen::Vector3d radial = w - t * a;
         const double d = radial.norm();
-        if (d < 1e-12) continue;
+        if (d < 1e-12)
+          continue;
         const Eigen::Vector3d n = radial / d;
         // Derivatives of the distance: centre shift along u, v; axis tilt towards u, v; radius.
         Eigen::Matrix<double, 5, 1> J;
@@ -91,15 +102,19 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
       }
       JtJ.diagonal() *= 1.0 + 1e-6;
       const Eigen::Matrix<double, 5, 1> step = JtJ.ldlt().solve(-Jtr);
-      if (!step.allFinite()) break;
+      if (!step.allFinite())
+        break;
       c += step(0) * u + step(1) * v;
       a = (a + step(2) * u + step(3) * v).normalized();
       r += step(4);
-      if (step.norm() < 1e-10) break;
+      if (step.norm() < 1e-10)
+        break;
     }
   }
-  if (!(r > 0.0) || !c.allFinite() || !a.allFinite()) return std::nullopt;
-  if (a.dot(axis_guess) < 0.0) a = -a;
+  if (!(r > 0.0) || !c.allFinite() || !a.allFinite())
+    return std::nullopt;
+  if (a.dot(axis_guess) < 0.0)
+    a = -a;
   Cylinder cyl;
   cyl.axis = a;
   cyl.center = c + (mean - c).dot(a) * a;
@@ -110,19 +125,22 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
 
 std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
                                        const CylinderRansacOptions& o, std::vector<int>* inliers) {
-  if (pts.size() < 6) return std::nullopt;
+  if (pts.size() < 6)
+    return std::nullopt;
   Rng rng(o.seed);
   const Eigen::Vector3d guess = axis_guess.normalized();
   std::vector<Eigen::Vector3d> axes{guess};
   const Eigen::Vector3d pca = principalAxis(pts);
   const Eigen::Vector3d pca_signed = pca.dot(guess) < 0.0 ? Eigen::Vector3d(-pca) : pca;
-  if (std::acos(std::min(1.0, pca_signed.dot(guess))) <= o.max_axis_deviation) axes.push_back(pca_signed);
+  if (std::acos(std::min(1.0, pca_signed.dot(guess))) <= o.max_axis_deviation)
+    axes.push_back(pca_signed);
   Eigen::Vector3d u, v;
   basis(guess, u, v);
   for (int i = 0; i < o.axis_candidates; ++i) {
     const double tilt = o.max_axis_deviation * std::sqrt(rng.uniform());
     const double az = rng.uniform(0.0, 2.0 * M_PI);
-    axes.push_back((std::cos(tilt) * guess + std::sin(tilt) * (std::cos(az) * u + std::sin(az) * v)).normalized());
+    axes.push_back((std::cos(tilt) * guess + std::sin(tilt) * (std::cos(az) * u + std::sin(az) * v))
+                       .normalized());
   }
   CircleRansacOptions co;
   co.threshold = o.threshold;
@@ -135,35 +153,42 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
     basis(axes[k], u, v);
     Points2 plane;
     plane.reserve(pts.size());
-    for (const auto& p : pts) plane.emplace_back(p.dot(u), p.dot(v));
+    for (const auto& p : pts)
+      plane.emplace_back(p.dot(u), p.dot(v));
     co.seed = o.seed * 1000003ULL + k;
     std::vector<int> in;
-    if (!ransacCircle(plane, co, &in)) continue;
+    if (!ransacCircle(plane, co, &in))
+      continue;
     if (in.size() > best_in.size()) {
       best_in = in;
       best_axis = axes[k];
     }
   }
-  if (best_in.size() < 6) return std::nullopt;
+  if (best_in.size() < 6)
+    return std::nullopt;
   Points sub;
-  for (const int i : best_in) sub.push_back(pts[i]);
+  for (const int i : best_in)
+    sub.push_back(pts[i]);
   auto cyl = fitCylinder(sub, best_axis);
   // The refinement may leave the radius bounds or the axis cone: fall back to a fixed axis.
   if (!cyl || cyl->radius < o.min_radius || cyl->radius > o.max_radius ||
       std::acos(std::min(1.0, std::abs(cyl->axis.dot(guess)))) > o.max_axis_deviation) {
     cyl = fitCylinder(sub, best_axis, true);
   }
-  if (!cyl || cyl->radius < o.min_radius || cyl->radius > o.max_radius) return std::nullopt;
+  if (!cyl || cyl->radius < o.min_radius || cyl->radius > o.max_radius)
+    return std::nullopt;
   if (inliers) {
     inliers->clear();
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (std::abs(axisDistance(*cyl, pts[i]) - cyl->radius) < o.threshold) inliers->push_back(static_cast<int>(i));
+      if (std::abs(axisDistance(*cyl, pts[i]) - cyl->radius) < o.threshold)
+        inliers->push_back(static_cast<int>(i));
     }
   }
   return cyl;
 }
 
-double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band, double min_radius) {
+double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
+                            double min_radius) {
   double sum = 0.0;
   int n = 0;
   for (const auto& p : pts) {
@@ -171,12 +196,12 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
     // radius the noise already inflated.
     const double d = axisDistance(c, p);
     if (d < c.radius + band) {
-
       sum += d * d;
       ++n;
     }
   }
-  if (n == 0) return c.radius;
+  if (n == 0)
+    return c.radius;
   const double r2 = sum / n - sigma * sigma;
   return std::max(min_radius, std::sqrt(std::max(0.0, r2)));
 }
@@ -187,17 +212,21 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 namespace dormant_tree_modeling {
 namespace modeling {
 
-std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess, double sigma,
-                                        double max_radius, std::uint64_t seed, std::vector<int>* inliers) {
+std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                        double sigma, double scatter, double max_radius,
+                                        std::uint64_t seed, std::vector<int>* inliers) {
   constexpr double MIN_RADIUS = 0.002;
   const int n = static_cast<int>(pts.size());
-  if (n < 6) return std::nullopt;
+  if (n < 6)
+    return std::nullopt;
   const double band = max_radius + std::max(2.5 * sigma, 0.004);
-  auto lineInliers = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d, std::vector<int>& out) {
+  auto lineInliers = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                         std::vector<int>& out) {
     out.clear();
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector3d w = pts[i] - o;
-      if ((w - w.dot(d) * d).squaredNorm() < band * band) out.push_back(i);
+      if ((w - w.dot(d) * d).squaredNorm() < band * band)
+        out.push_back(i);
     }
   };
   Rng rng(seed);
@@ -209,9 +238,11 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     const Eigen::Vector3d& a = pts[rng.uniformInt(0, n - 1)];
     const Eigen::Vector3d& b = pts[rng.uniformInt(0, n - 1)];
     Eigen::Vector3d d = b - a;
-    if (d.norm() < 4.0 * band) continue;
+    if (d.norm() < 4.0 * band)
+      continue;
     d.normalize();
-    if (std::abs(d.dot(axis_guess.normalized())) < std::cos(M_PI / 3.0)) continue;
+    if (std::abs(d.dot(axis_guess.normalized())) < std::cos(M_PI / 3.0))
+      continue;
     lineInliers(a, d, in);
     if (in.size() > best.size()) {
       best = in;
@@ -221,12 +252,14 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   }
   for (int round = 0; round < 2 && best.size() >= 6; ++round) {
     Points sub;
-    for (const int i : best) sub.push_back(pts[i]);
+    for (const int i : best)
+      sub.push_back(pts[i]);
     const Eigen::Vector3d d = principalAxis(sub, &origin);
     dir = d.dot(axis_guess) < 0.0 ? Eigen::Vector3d(-d) : d;
     lineInliers(origin, dir, best);
   }
-  if (best.size() < 6) return std::nullopt;
+  if (best.size() < 6)
+    return std::nullopt;
   Cylinder cyl;
   cyl.center = origin;
   cyl.axis = dir;
@@ -238,26 +271,32 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   std::vector<int> used;
   double radius = max_radius;
   for (int round = 0; round < 5; ++round) {
-    const double reach = radius + 2.5 * sigma + 0.002;
+    // The moment must see the whole scatter it then subtracts.
+    const double reach = radius + 2.5 * std::max(sigma, scatter) + 0.002;
+
     used.clear();
     std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
     for (const int i : best) {
-      if (axisDistance(cyl, pts[i]) >= reach) continue;
+      if (axisDistance(cyl, pts[i]) >= reach)
+        continue;
       used.push_back(i);
       const long key = static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE));
       auto it = centroids.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
       it->second.first += pts[i];
       ++it->second.second;
     }
-    if (used.size() < 6) return std::nullopt;
+    if (used.size() < 6)
+      return std::nullopt;
     Points centres;
     for (const auto& kv : centroids) {
-      if (kv.second.second >= 3) centres.push_back(kv.second.first / kv.second.second);
+      if (kv.second.second >= 3)
+        centres.push_back(kv.second.first / kv.second.second);
     }
     if (centres.size() >= 2) {
       Eigen::Vector3d c;
       Eigen::Vector3d d = principalAxis(centres, &c);
-      if (d.dot(axis_guess) < 0.0) d = -d;
+      if (d.dot(axis_guess) < 0.0)
+        d = -d;
       if (d.dot(cyl.axis) > std::cos(30.0 * M_PI / 180.0)) {
         cyl.center = c;
         cyl.axis = d;
@@ -266,8 +305,10 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     std::map<long, std::pair<double, int>> moments_by_slice;
     for (const int i : used) {
       const double dist = axisDistance(cyl, pts[i]);
-      if (dist >= reach) continue;
-      auto& m = moments_by_slice[static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))];
+      if (dist >= reach)
+        continue;
+      auto& m = moments_by_slice[static_cast<long>(
+          std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))];
       m.first += dist * dist;
       ++m.second;
     }
@@ -277,15 +318,18 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     for (const auto& kv : moments_by_slice) {
       total += kv.second.first;
       total_n += kv.second.second;
-      if (kv.second.second >= 6) moments.push_back(kv.second.first / kv.second.second);
+      if (kv.second.second >= 6)
+        moments.push_back(kv.second.first / kv.second.second);
     }
-    if (total_n < 6) return std::nullopt;
+    if (total_n < 6)
+      return std::nullopt;
     double moment = total / total_n;
     if (!moments.empty()) {
       std::nth_element(moments.begin(), moments.begin() + moments.size() / 2, moments.end());
       moment = moments[moments.size() / 2];
     }
-    radius = std::clamp(std::sqrt(std::max(0.0, moment - sigma * sigma)), MIN_RADIUS, max_radius);
+    radius =
+        std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_RADIUS, max_radius);
   }
   cyl.radius = radius;
   const int count = static_cast<int>(used.size());
@@ -300,7 +344,8 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   cyl.center += 0.5 * (lo + hi) * cyl.axis;
   cyl.length = hi - lo;
   cyl.mean_abs_error = abs_err / count;
-  if (inliers) *inliers = used;
+  if (inliers)
+    *inliers = used;
   return cyl;
 }
 

@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <limits>
 
-#include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -11,7 +11,8 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
   const int n = static_cast<int>(pts.size());
   std::vector<int> labels(n, 0);
   k = std::clamp(k, 1, std::max(1, n));
-  if (n == 0 || k == 1) return labels;
+  if (n == 0 || k == 1)
+    return labels;
   Rng rng(seed);
   // k-means++ seeding: each next centre drawn with probability proportional to D^2.
   std::vector<Eigen::Vector3d> centres{pts[rng.uniformInt(0, n - 1)]};
@@ -22,7 +23,8 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
       d2[i] = std::min(d2[i], (pts[i] - centres.back()).squaredNorm());
       total += d2[i];
     }
-    if (total <= 0.0) break;  // fewer distinct points than k
+    if (total <= 0.0)
+      break;  // fewer distinct points than k
     double pick = rng.uniform() * total;
     int chosen = n - 1;
     for (int i = 0; i < n; ++i) {
@@ -59,15 +61,18 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
       ++counts[labels[i]];
     }
     for (int c = 0; c < k; ++c) {
-      if (counts[c] > 0) centres[c] = sums[c] / counts[c];
+      if (counts[c] > 0)
+        centres[c] = sums[c] / counts[c];
     }
-    if (!changed && it > 0) break;
+    if (!changed && it > 0)
+      break;
   }
   // Renumber so that every label in [0, k') is used (an emptied centre leaves a gap).
   std::vector<int> remap(k, -1);
   int next = 0;
   for (int& l : labels) {
-    if (remap[l] < 0) remap[l] = next++;
+    if (remap[l] < 0)
+      remap[l] = next++;
     l = remap[l];
   }
   return labels;

@@ -18,7 +18,8 @@ template <typename T>
 void check(const char* name, T value, T lo, T hi) {
   if (!(value >= lo && value <= hi)) {
     std::ostringstream s;
-    s << "tree modeler parameter " << name << " = " << value << " is outside [" << lo << ", " << hi << "]";
+    s << "tree modeler parameter " << name << " = " << value << " is outside [" << lo << ", " << hi
+      << "]";
     throw Error(ErrorCode::INVALID_ARGUMENT, s.str());
   }
 }
@@ -60,6 +61,7 @@ const std::map<std::string, Setter>& setters() {
       {"ours_correct_noise_bias", setter(&C::ours_correct_noise_bias)},
       {"ours_branch_shell", setter(&C::ours_branch_shell)},
       {"noise_sigma", setter(&C::noise_sigma)},
+      {"beam_spread", setter(&C::beam_spread)},
       {"trunk_max_tilt", setter(&C::trunk_max_tilt)},
       {"radius_continuity", setter(&C::radius_continuity)},
       {"branch_max_radial_angle", setter(&C::branch_max_radial_angle)},
@@ -109,6 +111,8 @@ void ModelerConfig::validate() const {
   check("branch_min_points", branch_min_points, 6, 1000000);
   check("branch_fit_length", branch_fit_length, 0.05, 2.0);
   check("noise_sigma", noise_sigma, -1.0, 0.1);
+  check("beam_spread", beam_spread, 0.0, 0.1);
+
   check("trunk_max_tilt", trunk_max_tilt, 1.0, 90.0);
   check("radius_continuity", radius_continuity, 0.01, 10.0);
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
@@ -129,13 +133,16 @@ ModelerConfig loadModelerConfig(const std::string& path) {
   ModelerConfig config;
   try {
     YAML::Node root = YAML::LoadFile(path);
-    if (root.IsMap() && root["tree_modeler"]) root = root["tree_modeler"];
-    if (!root.IsMap()) throw Error(ErrorCode::PARSE_ERROR, path + ": expected a map of parameters");
+    if (root.IsMap() && root["tree_modeler"])
+      root = root["tree_modeler"];
+    if (!root.IsMap())
+      throw Error(ErrorCode::PARSE_ERROR, path + ": expected a map of parameters");
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();
       const auto it = setters().find(key);
       if (it == setters().end()) {
-        throw Error(ErrorCode::PARSE_ERROR, path + ": unknown tree modeler parameter '" + key + "'");
+        throw Error(ErrorCode::PARSE_ERROR,
+                    path + ": unknown tree modeler parameter '" + key + "'");
       }
       try {
         it->second(config, kv.second);

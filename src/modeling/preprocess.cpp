@@ -24,14 +24,18 @@ constexpr int MAX_WIRES = 10;
 
 /// Removes points near a near-horizontal plane at the bottom of the cloud, if it is large.
 std::size_t removeGround(Points& pts, std::uint64_t seed) {
-  if (pts.size() < 100) return 0;
+  if (pts.size() < 100)
+    return 0;
   double zmin = 1e300;
-  for (const auto& p : pts) zmin = std::min(zmin, p.z());
+  for (const auto& p : pts)
+    zmin = std::min(zmin, p.z());
   std::vector<int> low;
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (pts[i].z() < zmin + 0.15) low.push_back(static_cast<int>(i));
+    if (pts[i].z() < zmin + 0.15)
+      low.push_back(static_cast<int>(i));
   }
-  if (low.size() < 50) return 0;
+  if (low.size() < 50)
+    return 0;
   Rng rng(seed);
   Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
   double best_d = 0.0;
@@ -41,13 +45,17 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
     const auto& b = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
     const auto& c = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
     Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() < 1e-9) continue;
+    if (n.norm() < 1e-9)
+      continue;
     n.normalize();
-    if (n.z() < 0) n = -n;
-    if (n.z() < std::cos(15.0 * M_PI / 180.0)) continue;
+    if (n.z() < 0)
+      n = -n;
+    if (n.z() < std::cos(15.0 * M_PI / 180.0))
+      continue;
     const double d = -n.dot(a);
     std::size_t count = 0;
-    for (const int i : low) count += std::abs(n.dot(pts[i]) + d) < 0.02;
+    for (const int i : low)
+      count += std::abs(n.dot(pts[i]) + d) < 0.02;
     if (count > best_count) {
       best_count = count;
       best_n = n;
@@ -62,28 +70,33 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
       hi = hi.cwiseMax(pts[i].head<2>());
     }
   }
-  if (best_count < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT) return 0;
+  if (best_count < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT)
+    return 0;
   const std::size_t before = pts.size();
-  pts.erase(std::remove_if(pts.begin(), pts.end(),
-                           [&](const Eigen::Vector3d& p) { return best_n.dot(p) + best_d < GROUND_BAND; }),
+  pts.erase(std::remove_if(
+                pts.begin(), pts.end(),
+                [&](const Eigen::Vector3d& p) { return best_n.dot(p) + best_d < GROUND_BAND; }),
             pts.end());
   return before - pts.size();
 }
 
 /// Longest run of projections along a line without a gap above WIRE_MAX_GAP.
 double longestRun(std::vector<double>& t) {
-  if (t.empty()) return 0.0;
+  if (t.empty())
+    return 0.0;
   std::sort(t.begin(), t.end());
   double best = 0.0, start = t[0];
   for (std::size_t i = 1; i < t.size(); ++i) {
-    if (t[i] - t[i - 1] > WIRE_MAX_GAP) start = t[i];
+    if (t[i] - t[i - 1] > WIRE_MAX_GAP)
+      start = t[i];
     best = std::max(best, t[i] - start);
   }
   return best;
 }
 
 std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
-  if (pts.size() < 100) return 0;
+  if (pts.size() < 100)
+    return 0;
   // Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
   // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points.
   const PointIndex index(pts);
@@ -91,9 +104,11 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   std::vector<int> candidates;
   for (std::size_t i = 0; i < pts.size(); i += stride) {
     const auto nn = index.within(pts[i], WIRE_NEIGHBOURHOOD);
-    if (nn.size() < 8) continue;
+    if (nn.size() < 8)
+      continue;
     Points local;
-    for (const int j : nn) local.push_back(pts[j]);
+    for (const int j : nn)
+      local.push_back(pts[j]);
     Eigen::Vector3d eig;
     const Eigen::Vector3d dir = principalAxis(local, nullptr, &eig);
     if (eig(1) < WIRE_LINEARITY * eig(2) && std::abs(dir.z()) < std::sin(WIRE_MAX_TILT)) {
@@ -111,9 +126,11 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
       const Eigen::Vector3d& a = pts[candidates[rng.uniformInt(0, n - 1)]];
       const Eigen::Vector3d& b = pts[candidates[rng.uniformInt(0, n - 1)]];
       Eigen::Vector3d d = b - a;
-      if (d.norm() < 0.3) continue;
+      if (d.norm() < 0.3)
+        continue;
       d.normalize();
-      if (std::abs(d.z()) > std::sin(WIRE_MAX_TILT)) continue;
+      if (std::abs(d.z()) > std::sin(WIRE_MAX_TILT))
+        continue;
       std::size_t count = 0;
       for (const int i : candidates) {
         const Eigen::Vector3d w = pts[i] - a;
@@ -125,7 +142,8 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
         best_d = d;
       }
     }
-    if (best_count < 5) break;
+    if (best_count < 5)
+      break;
     std::vector<double> along;
     std::vector<int> inliers;
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -139,10 +157,12 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
     std::vector<int> rest;
     for (const int i : candidates) {
       const Eigen::Vector3d w = pts[i] - best_o;
-      if ((w - w.dot(best_d) * best_d).squaredNorm() >= WIRE_BAND * WIRE_BAND) rest.push_back(i);
+      if ((w - w.dot(best_d) * best_d).squaredNorm() >= WIRE_BAND * WIRE_BAND)
+        rest.push_back(i);
     }
     candidates.swap(rest);
-    if (longestRun(along) < min_length) continue;
+    if (longestRun(along) < min_length)
+      continue;
     for (const int i : inliers) {
       removed += !drop[i];
       drop[i] = 1;
@@ -151,7 +171,8 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   Points kept;
   kept.reserve(pts.size() - removed);
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (!drop[i]) kept.push_back(pts[i]);
+    if (!drop[i])
+      kept.push_back(pts[i]);
   }
   pts.swap(kept);
   return removed;
@@ -160,7 +181,8 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
 }  // namespace
 
 Points voxelDownsample(const Points& pts, double voxel) {
-  if (voxel <= 0.0) return pts;
+  if (voxel <= 0.0)
+    return pts;
   std::map<std::tuple<long, long, long>, std::pair<Eigen::Vector3d, int>> cells;
   for (const auto& p : pts) {
     const auto key = std::make_tuple(static_cast<long>(std::floor(p.x() / voxel)),
@@ -170,11 +192,11 @@ Points voxelDownsample(const Points& pts, double voxel) {
     auto it = cells.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
     it->second.first += p;
     ++it->second.second;
-
   }
   Points out;
   out.reserve(cells.size());
-  for (const auto& kv : cells) out.push_back(kv.second.first / kv.second.second);
+  for (const auto& kv : cells)
+    out.push_back(kv.second.first / kv.second.second);
   return out;
 }
 
@@ -196,14 +218,16 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
     const auto mask = floatingMask(out, config.floating_radius, config.floating_min_neighbors);
     Points kept;
     for (std::size_t i = 0; i < out.size(); ++i) {
-      if (!mask[i]) kept.push_back(out[i]);
+      if (!mask[i])
+        kept.push_back(out[i]);
     }
     s.floating = out.size() - kept.size();
     out.swap(kept);
     s.ground = removeGround(out, config.seed + 11);
     s.wires = removeWires(out, config.wire_min_length, config.seed + 13);
   }
-  if (stats) *stats = s;
+  if (stats)
+    *stats = s;
   return out;
 }
 

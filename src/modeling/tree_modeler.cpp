@@ -4,10 +4,10 @@
 #include <pcl/point_types.h>
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 
@@ -55,10 +55,12 @@ CylinderModel toModel(const Cylinder& c, int id, std::size_t inliers, std::size_
 /// estimateNoiseSigma). The slices refine it later.
 double noiseGuess(const Points& pts, const Cluster& cluster) {
   std::vector<double> res;
-  for (const int i : cluster.members) res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
+  for (const int i : cluster.members)
+    res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
   std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
   const double med = res[res.size() / 2];
-  for (double& r : res) r = std::abs(r - med);
+  for (double& r : res)
+    r = std::abs(r - med);
   std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
   return 1.4826 * res[res.size() / 2] * std::sqrt(1.5);
 }
@@ -70,11 +72,13 @@ double noiseGuess(const Points& pts, const Cluster& cluster) {
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config) {
   double zmin = std::numeric_limits<double>::infinity();
-  for (const auto& c : clusters) zmin = std::min(zmin, c.centroid.z());
+  for (const auto& c : clusters)
+    zmin = std::min(zmin, c.centroid.z());
   std::vector<int> candidates{path.trunk.front()};
   for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
     const auto& fit = clusters[c].fit;
-    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + 0.3 && fit && fit->radius < 0.3 &&
+    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + 0.3 && fit &&
+        fit->radius < 0.3 &&
         static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
         std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0)) {
       candidates.push_back(c);
@@ -92,13 +96,16 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
   std::optional<TrackedTrunk> best;
   double best_score = -1.0;
   for (const int c : candidates) {
-    if (!clusters[c].fit) continue;
+    if (!clusters[c].fit)
+      continue;
     const Cylinder& first = *clusters[c].fit;
     const Eigen::Vector3d up = first.axis.z() < 0.0 ? Eigen::Vector3d(-first.axis) : first.axis;
     const Eigen::Vector3d start = first.center - 0.5 * first.length * up;
-    const double threshold = std::max(0.5 * config.circle_threshold, 2.5 * noiseGuess(pts, clusters[c]));
+    const double threshold =
+        std::max(0.5 * config.circle_threshold, 2.5 * noiseGuess(pts, clusters[c]));
     TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
-    if (tracked.centers.size() < 3) continue;
+    if (tracked.centers.size() < 3)
+      continue;
     double shell = 0.0;
     for (std::size_t k = 0; k < tracked.centers.size(); k += 2) {
       const double r = tracked.radii[k];
@@ -117,13 +124,16 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
 
 }  // namespace
 
-TreeModeler::TreeModeler(const ModelerConfig& config) : config_(config) { config_.validate(); }
+TreeModeler::TreeModeler(const ModelerConfig& config) : config_(config) {
+  config_.validate();
+}
 
 ModelResult TreeModeler::model(const Cloud& cloud) const {
   Points pts;
   pts.reserve(cloud.size());
   for (const auto& p : cloud.points) {
-    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) pts.emplace_back(p.x, p.y, p.z);
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
+      pts.emplace_back(p.x, p.y, p.z);
   }
   return model(pts);
 }
@@ -133,28 +143,33 @@ ModelResult TreeModeler::model(const Points& input) const {
   ModelResult result;
   Stopwatch watch(result.timings);
   std::size_t finite = 0;
-  for (const auto& p : input) finite += p.allFinite();
+  for (const auto& p : input)
+    finite += p.allFinite();
   if (finite < MIN_POINTS) {
-    throw Error(ErrorCode::EMPTY_INPUT, "cloud has " + std::to_string(finite) + " finite points; at least " +
-                                            std::to_string(MIN_POINTS) + " are needed to model a tree");
+    throw Error(ErrorCode::EMPTY_INPUT,
+                "cloud has " + std::to_string(finite) + " finite points; at least " +
+                    std::to_string(MIN_POINTS) + " are needed to model a tree");
   }
   Points clean;
   clean.reserve(finite);
   for (const auto& p : input) {
-    if (p.allFinite()) clean.push_back(p);
+    if (p.allFinite())
+      clean.push_back(p);
   }
   result.points = preprocess(clean, config_, &result.preprocess);
   const Points& pts = result.points;
   watch.lap("preprocess");
   if (pts.size() < MIN_POINTS) {
-    throw Error(ErrorCode::EMPTY_INPUT, "only " + std::to_string(pts.size()) + " points left after preprocessing");
+    throw Error(ErrorCode::EMPTY_INPUT,
+                "only " + std::to_string(pts.size()) + " points left after preprocessing");
   }
 
   // Algorithm 2.
   auto clusters = initialClusters(pts, config_);
   watch.lap("kmeans");
-  result.split_error = config_.ours_derive_parameters ? derivedSplitError(clusters, config_.split_error)
-                                                      : config_.split_error;
+  result.split_error = config_.ours_derive_parameters
+                           ? derivedSplitError(clusters, config_.split_error)
+                           : config_.split_error;
   clusters = splitClusters(pts, std::move(clusters), result.split_error, config_);
   clusters = mergeClusters(pts, std::move(clusters), config_.merge_distance);
   watch.lap("split_merge");
@@ -174,14 +189,18 @@ ModelResult TreeModeler::model(const Points& input) const {
   }
   if (path.trunk.size() == 1) {
     const auto& c = clusters[path.trunk[0]];
-    if (!c.fit) throw Error(ErrorCode::NO_TRUNK, "no trunk: the lowest cluster is not cylindrical");
-    axis = {c.fit->center - 0.5 * c.fit->length * c.fit->axis, c.fit->center + 0.5 * c.fit->length * c.fit->axis};
+    if (!c.fit)
+      throw Error(ErrorCode::NO_TRUNK, "no trunk: the lowest cluster is not cylindrical");
+    axis = {c.fit->center - 0.5 * c.fit->length * c.fit->axis,
+            c.fit->center + 0.5 * c.fit->length * c.fit->axis};
   }
-  for (const int c : path.primary) region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
+  for (const int c : path.primary)
+    region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
   std::sort(region.begin(), region.end());
   std::vector<double> radii;
   for (const int c : path.trunk) {
-    if (clusters[c].fit && clusters[c].fit->radius < 0.3) radii.push_back(clusters[c].fit->radius);
+    if (clusters[c].fit && clusters[c].fit->radius < 0.3)
+      radii.push_back(clusters[c].fit->radius);
   }
   std::sort(radii.begin(), radii.end());
   double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
@@ -199,12 +218,12 @@ ModelResult TreeModeler::model(const Points& input) const {
       for (std::size_t i = 0; i < pts.size(); ++i) {
         double d = 0.0;
         const double s = line.project(pts[i], &d);
-        if (d <= reach && s >= -0.05 && s <= line.length() + 0.05) region.push_back(static_cast<int>(i));
+        if (d <= reach && s >= -0.05 && s <= line.length() + 0.05)
+          region.push_back(static_cast<int>(i));
       }
     }
   }
   const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
-
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
@@ -222,9 +241,11 @@ ModelResult TreeModeler::model(const Points& input) const {
     std::size_t inliers = 0, total = 0;
     for (const int k : region) {
       const double s = trunk.centerline.project(pts[k]);
-      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second) continue;
+      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second)
+        continue;
       ++total;
-      if (std::abs(axisDistance(c, pts[k]) - c.radius) < std::max(config_.cylinder_threshold, 2.5 * trunk.noise_sigma)) {
+      if (std::abs(axisDistance(c, pts[k]) - c.radius) <
+          std::max(config_.cylinder_threshold, 2.5 * trunk.noise_sigma)) {
         ++inliers;
         result.classes[k] = PointClass::TRUNK;
       }
@@ -235,7 +256,8 @@ ModelResult TreeModeler::model(const Points& input) const {
   for (std::size_t b = 0; b < branches.size(); ++b) {
     const BranchFit& f = branches[b];
     PrimaryBranch pb;
-    pb.cylinder = toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(), f.inliers.size());
+    pb.cylinder = toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(),
+                          f.inliers.size());
     pb.trunk_segment = f.trunk_segment;
     const Cylinder& seg = trunk.cylinders[f.trunk_segment];
     pb.measurement.attachment_height = f.attachment.z() - base_z;
@@ -244,7 +266,8 @@ ModelResult TreeModeler::model(const Points& input) const {
     pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
     pb.measurement.prune = pb.measurement.diameter_ratio > config_.prune_ratio;
     model.primary_branches.push_back(pb);
-    for (const int k : f.inliers) result.classes[k] = PointClass::PRIMARY;
+    for (const int k : f.inliers)
+      result.classes[k] = PointClass::PRIMARY;
   }
   model.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -3,9 +3,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
@@ -16,7 +16,7 @@ namespace modeling {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-constexpr double ZERO_SLOPE = 0.05;       // |d eta_share| below this is a flat eta
+constexpr double ZERO_SLOPE = 0.05;  // |d eta_share| below this is a flat eta
 constexpr int MIN_SLICE_POINTS = 12;
 constexpr double MIN_TRUNK_RADIUS = 0.003;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
@@ -26,7 +26,8 @@ struct Projected {
 };
 
 double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
+  if (v.empty())
+    return 0.0;
   const std::size_t m = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + m, v.end());
   return v[m];
@@ -40,11 +41,12 @@ struct SliceBounds {
   double max_distance = 1e300;
 };
 
-std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region, const Centerline& line,
-                                 const std::vector<double>& s, const std::vector<double>& dist, double height,
-                                 double threshold, const SliceBounds& bounds,
-                                 const std::vector<double>* expected_radius, double continuity, double sigma,
-                                 const ModelerConfig& config) {
+std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
+                                 const Centerline& line, const std::vector<double>& s,
+                                 const std::vector<double>& dist, double height, double threshold,
+                                 const SliceBounds& bounds,
+                                 const std::vector<double>* expected_radius, double continuity,
+                                 double sigma, const ModelerConfig& config) {
   double lo = 1e300, hi = -1e300;
   for (const double v : s) {
     lo = std::min(lo, v);
@@ -56,7 +58,8 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
   std::vector<std::vector<int>> members(count);
   for (std::size_t k = 0; k < region.size(); ++k) {
     const int n = static_cast<int>(std::floor((s[k] - lo) / height));
-    if (n >= 0 && n < count && dist[k] <= bounds.max_distance) members[n].push_back(region[k]);
+    if (n >= 0 && n < count && dist[k] <= bounds.max_distance)
+      members[n].push_back(region[k]);
   }
   std::vector<Slice> slices(count);
   for (int n = 0; n < count; ++n) {
@@ -72,7 +75,8 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     const Eigen::Vector3d origin = line.pointAt(mid), dir = line.directionAt(mid);
     const Eigen::Vector3d u = dir.unitOrthogonal(), v = dir.cross(u);
     Points2 plane;
-    for (const int i : members[n]) plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
+    for (const int i : members[n])
+      plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
     CircleRansacOptions o;
     o.threshold = threshold;
     o.iterations = config.ransac_iterations;
@@ -94,16 +98,26 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
       sl.center = origin + circle->center.x() * u + circle->center.y() * v;
       sl.corrected_radius = sl.radius;
       if (sigma > 0.0) {
-        double sum = 0.0;
-        int count_in = 0;
-        for (const auto& q : plane) {
-          const double d = (q - circle->center).norm();
-          if (d < sl.radius + 2.5 * sigma) {
-            sum += d * d;
-            ++count_in;
+        // Second moment inside a window of radius + 1.5 sigma, iterated: branches leaving the
+        // trunk only add points outside the surface, so a tight outer window keeps most of
+        // them out. For a radial scatter truncated at +1.5 sigma the moment is
+        // (r - 0.139 sigma)^2 + 0.773 sigma^2 (truncated normal), solved here for r.
+        double r = sl.radius;
+        for (int round = 0; round < 4; ++round) {
+          double sum = 0.0;
+          int count_in = 0;
+          for (const auto& q : plane) {
+            const double d = (q - circle->center).norm();
+            if (d < r + 1.5 * sigma) {
+              sum += d * d;
+              ++count_in;
+            }
           }
+          if (count_in == 0)
+            break;
+          r = 0.139 * sigma + std::sqrt(std::max(0.0, sum / count_in - 0.773 * sigma * sigma));
         }
-        if (count_in > 0) sl.corrected_radius = std::sqrt(std::max(0.0, sum / count_in - sigma * sigma));
+        sl.corrected_radius = r;
       }
     }
   }
@@ -119,7 +133,8 @@ std::vector<Eigen::Vector3d> smoothAxis(const std::vector<Eigen::Vector3d>& cent
     z0 = std::min(z0, c.z());
     z1 = std::max(z1, c.z());
   }
-  if (pts.size() < 2 || z1 - z0 < 1e-6) return centres;
+  if (pts.size() < 2 || z1 - z0 < 1e-6)
+    return centres;
   const double span = z1 - z0;
   Eigen::Vector4d cx = Eigen::Vector4d::Zero(), cy = Eigen::Vector4d::Zero();
   for (int round = 0; round < 3; ++round) {
@@ -128,7 +143,8 @@ std::vector<Eigen::Vector3d> smoothAxis(const std::vector<Eigen::Vector3d>& cent
     Eigen::VectorXd bx(pts.size()), by(pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const double t = (pts[i].z() - z0) / span;
-      for (int k = 0; k <= degree; ++k) A(i, k) = std::pow(t, k);
+      for (int k = 0; k <= degree; ++k)
+        A(i, k) = std::pow(t, k);
       bx(i) = pts[i].x();
       by(i) = pts[i].y();
     }
@@ -137,20 +153,24 @@ std::vector<Eigen::Vector3d> smoothAxis(const std::vector<Eigen::Vector3d>& cent
     cy.setZero();
     cx.head(degree + 1) = qr.solve(bx);
     cy.head(degree + 1) = qr.solve(by);
-    if (round == 2) break;
+    if (round == 2)
+      break;
     std::vector<double> res;
     auto residual = [&](const Eigen::Vector3d& p) {
       const double t = (p.z() - z0) / span;
       const Eigen::Vector4d T(1, t, t * t, t * t * t);
       return std::hypot(p.x() - cx.dot(T), p.y() - cy.dot(T));
     };
-    for (const auto& p : pts) res.push_back(residual(p));
+    for (const auto& p : pts)
+      res.push_back(residual(p));
     const double limit = std::max(0.01, 2.5 * median(res));
     std::vector<Eigen::Vector3d> kept;
     for (const auto& p : pts) {
-      if (residual(p) <= limit) kept.push_back(p);
+      if (residual(p) <= limit)
+        kept.push_back(p);
     }
-    if (kept.size() < 4) break;
+    if (kept.size() < 4)
+      break;
     pts.swap(kept);
   }
   std::vector<Eigen::Vector3d> out;
@@ -170,7 +190,8 @@ std::vector<double> expectedRadii(const std::vector<Slice>& slices) {
   for (std::size_t n = 0; n < slices.size(); ++n) {
     std::vector<double> r;
     for (std::size_t k = n >= 3 ? n - 3 : 0; k < std::min(slices.size(), n + 4); ++k) {
-      if (slices[k].has_circle) r.push_back(slices[k].radius);
+      if (slices[k].has_circle)
+        r.push_back(slices[k].radius);
     }
     out[n] = median(r);
   }
@@ -178,30 +199,36 @@ std::vector<double> expectedRadii(const std::vector<Slice>& slices) {
 }
 
 /// The centreline through the slice circles that sit near the current one.
-Centerline refineCenterline(const std::vector<Slice>& slices, const Centerline& current, double radius,
-                            double step) {
+Centerline refineCenterline(const std::vector<Slice>& slices, const Centerline& current,
+                            double radius, double step) {
   std::vector<Eigen::Vector3d> centres;
   for (const auto& sl : slices) {
     double d = 0.0;
     current.project(sl.center, &d);
-    if (sl.has_circle && d < radius) centres.push_back(sl.center);
+    if (sl.has_circle && d < radius)
+      centres.push_back(sl.center);
   }
-  if (centres.size() < 4) return current;
+  if (centres.size() < 4)
+    return current;
   return Centerline(smoothAxis(centres, step));
 }
 
-
-std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& region, const std::vector<double>& s,
-                                   const std::vector<double>& dist, const SliceBounds& bounds, double a, double b,
-                                   const Centerline& line, const std::vector<Slice>& slices, double threshold,
-                                   double sigma, const ModelerConfig& config, std::uint64_t stream) {
+std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& region,
+                                   const std::vector<double>& s, const std::vector<double>& dist,
+                                   const SliceBounds& bounds, double a, double b,
+                                   const Centerline& line, const std::vector<Slice>& slices,
+                                   double threshold, double sigma, const ModelerConfig& config,
+                                   std::uint64_t stream) {
   Points sub;
   for (std::size_t k = 0; k < region.size(); ++k) {
-    if (s[k] >= a && s[k] < b && dist[k] <= bounds.max_distance) sub.push_back(pts[region[k]]);
+    if (s[k] >= a && s[k] < b && dist[k] <= bounds.max_distance)
+      sub.push_back(pts[region[k]]);
   }
-  if (sub.size() < static_cast<std::size_t>(MIN_SLICE_POINTS)) return std::nullopt;
+  if (sub.size() < static_cast<std::size_t>(MIN_SLICE_POINTS))
+    return std::nullopt;
   Eigen::Vector3d axis = (line.pointAt(b) - line.pointAt(a)).normalized();
-  if (!axis.allFinite()) axis = Eigen::Vector3d::UnitZ();
+  if (!axis.allFinite())
+    axis = Eigen::Vector3d::UnitZ();
   CylinderRansacOptions o;
   o.threshold = threshold;
   o.circle_iterations = config.ransac_iterations;
@@ -212,7 +239,8 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
   if (config.ours_constrain_ransac) {
     std::vector<double> r;
     for (const auto& sl : slices) {
-      if (sl.has_circle && sl.s0 + 1e-9 >= a - 0.5 * config.slice_height && sl.s0 < b) r.push_back(sl.radius);
+      if (sl.has_circle && sl.s0 + 1e-9 >= a - 0.5 * config.slice_height && sl.s0 < b)
+        r.push_back(sl.radius);
     }
     const double expected = median(r);
     if (expected > 0.0) {
@@ -223,31 +251,34 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
   }
   std::vector<int> inliers;
   auto cyl = ransacCylinder(sub, axis, o, &inliers);
-  if (!cyl) return std::nullopt;
+  if (!cyl)
+    return std::nullopt;
   if (config.ours_constrain_ransac &&
       std::acos(std::clamp(cyl->axis.z(), -1.0, 1.0)) > config.trunk_max_tilt * DEG) {
     return std::nullopt;
   }
-  if (cyl->axis.z() < 0.0) cyl->axis = -cyl->axis;
+  if (cyl->axis.z() < 0.0)
+    cyl->axis = -cyl->axis;
   if (config.ours_correct_noise_bias) {
     // Median over the segment's slices of their noise-corrected radii: slices at branch
     // junctions, whose points include the branch's base, are the minority.
     std::vector<double> r;
     for (const auto& sl : slices) {
-      if (sl.has_circle && sl.s0 + 0.5 * config.slice_height >= a && sl.s0 + 0.5 * config.slice_height < b) {
+      if (sl.has_circle && sl.s0 + 0.5 * config.slice_height >= a &&
+          sl.s0 + 0.5 * config.slice_height < b) {
         r.push_back(sl.corrected_radius);
       }
     }
     if (r.empty()) {
       Points in;
-      for (const int i : inliers) in.push_back(sub[i]);
+      for (const int i : inliers)
+        in.push_back(sub[i]);
       cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_TRUNK_RADIUS);
     } else {
       cyl->radius = std::max(MIN_TRUNK_RADIUS, median(r));
     }
   }
   return cyl;
-
 }
 
 }  // namespace
@@ -268,7 +299,8 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     Points2 plane;
     for (const int i : index.within(predicted, std::hypot(0.5 * h, lateral))) {
       const Eigen::Vector3d w = pts[i] - predicted;
-      if (std::abs(w.dot(t)) <= 0.5 * h) plane.emplace_back(w.dot(u), w.dot(v));
+      if (std::abs(w.dot(t)) <= 0.5 * h)
+        plane.emplace_back(w.dot(u), w.dot(v));
     }
     CircleRansacOptions o;
     o.threshold = threshold;
@@ -297,19 +329,25 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
             inliers.push_back(static_cast<int>(k));
           }
         }
-        if (inliers.empty()) break;
+        if (inliers.empty())
+          break;
         centre = sum / static_cast<double>(inliers.size());
       }
       double m2 = 0.0;
-      for (const int k : inliers) m2 += (plane[k] - centre).squaredNorm();
+      for (const int k : inliers)
+        m2 += (plane[k] - centre).squaredNorm();
       if (!inliers.empty()) {
         const double est = std::sqrt(std::max(0.0, m2 / inliers.size() - sigma * sigma));
         circle = Circle{centre, std::clamp(est, o.min_radius, o.max_radius)};
       }
     }
 
-    const bool ok = circle && inliers.size() >= MIN_SLICE_POINTS / 2 && circle->center.norm() < r + 0.02;
-    if (getenv("DTM_DEBUG_TRACK")) fprintf(stderr, "  step z=%.2f n=%zu r=%.3f circle=%d cr=%.3f inl=%zu off=%.3f\n", predicted.z(), plane.size(), r, circle ? 1 : 0, circle ? circle->radius : 0.0, inliers.size(), circle ? circle->center.norm() : 0.0);
+    const bool ok =
+        circle && inliers.size() >= MIN_SLICE_POINTS / 2 && circle->center.norm() < r + 0.02;
+    if (getenv("DTM_DEBUG_TRACK"))
+      fprintf(stderr, "  step z=%.2f n=%zu r=%.3f circle=%d cr=%.3f inl=%zu off=%.3f\n",
+              predicted.z(), plane.size(), r, circle ? 1 : 0, circle ? circle->radius : 0.0,
+              inliers.size(), circle ? circle->center.norm() : 0.0);
     if (!ok) {
       ++misses;
       c = predicted;
@@ -320,7 +358,8 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     if (!out.centers.empty()) {
       const Eigen::Vector3d step_dir = (centre - out.centers.back()).normalized();
       // Smooth the direction: one slice's centre is noisy, the trunk bends slowly.
-      if (step_dir.allFinite() && step_dir.dot(t) > 0.5) t = (0.7 * t + 0.3 * step_dir).normalized();
+      if (step_dir.allFinite() && step_dir.dot(t) > 0.5)
+        t = (0.7 * t + 0.3 * step_dir).normalized();
     }
     r = 0.7 * r + 0.3 * circle->radius;
     c = centre;
@@ -330,40 +369,46 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
   return out;
 }
 
-double estimateNoiseSigma(
-const Points& pts, const Centerline& line, const std::vector<Slice>& slices,
-                          double slice_height) {
+double estimateNoiseSigma(const Points& pts, const Centerline& line,
+                          const std::vector<Slice>& slices, double slice_height) {
   std::vector<double> residuals;
   for (const auto& sl : slices) {
-    if (!sl.has_circle || sl.radius < 0.02) continue;
+    if (!sl.has_circle || sl.radius < 0.02)
+      continue;
     const Eigen::Vector3d dir = line.directionAt(sl.s0 + 0.5 * slice_height);
     for (const auto& p : pts) {
       const Eigen::Vector3d w = p - sl.center;
       const double along = w.dot(dir);
-      if (std::abs(along) > 0.5 * slice_height) continue;
+      if (std::abs(along) > 0.5 * slice_height)
+        continue;
       const double d = (w - along * dir).norm() - sl.radius;
-      if (std::abs(d) < 0.5 * sl.radius) residuals.push_back(d);
+      if (std::abs(d) < 0.5 * sl.radius)
+        residuals.push_back(d);
     }
   }
-  if (residuals.size() < 200) return -1.0;
+  if (residuals.size() < 200)
+    return -1.0;
   const double m = median(residuals);
-  for (double& r : residuals) r = std::abs(r - m);
+  for (double& r : residuals)
+    r = std::abs(r - m);
   return 1.4826 * median(residuals) * std::sqrt(1.5);
 }
 
-std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height, int zero_run,
-                                          double top) {
+std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height,
+                                          int zero_run, double top) {
   std::vector<double> cuts{slices.empty() ? 0.0 : std::max(0.0, slices.front().s0)};
   int flat = 0;
   for (std::size_t n = 1; n < slices.size(); ++n) {
     const double d = slices[n].outlier_share - slices[n - 1].outlier_share;
     if (d > ZERO_SLOPE && flat >= zero_run) {
       const double s = slices[n].s0;
-      if (s - cuts.back() > slice_height * 0.99) cuts.push_back(s);
+      if (s - cuts.back() > slice_height * 0.99)
+        cuts.push_back(s);
     }
     flat = std::abs(d) <= ZERO_SLOPE ? flat + 1 : 0;
   }
-  if (top - cuts.back() > 1e-9) cuts.push_back(top);
+  if (top - cuts.back() > 1e-9)
+    cuts.push_back(top);
   return cuts;
 }
 
@@ -378,7 +423,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   Centerline line(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   std::vector<double> s(region.size()), dist(region.size());
   auto projectAll = [&] {
-    for (std::size_t k = 0; k < region.size(); ++k) s[k] = line.project(pts[region[k]], &dist[k]);
+    for (std::size_t k = 0; k < region.size(); ++k)
+      s[k] = line.project(pts[region[k]], &dist[k]);
   };
   projectAll();
   // Slice circles stay near the radius of the trunk clusters (a circle through branch points
@@ -390,44 +436,52 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     bounds.max_distance = std::max(3.0 * initial_radius, initial_radius + 0.05);
   }
   // Pass 1: slices on the initial axis, to refine the centreline and estimate the noise.
-  auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr, 0.0, 0.0, config);
+  auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds,
+                              nullptr, 0.0, 0.0, config);
   for (int round = 0; round < 2; ++round) {
     line = refineCenterline(slices, line, std::max(initial_radius, 0.02), h);
     projectAll();
-    slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr, 0.0, 0.0, config);
+    slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr,
+                           0.0, 0.0, config);
   }
 
   Points region_pts;
-  for (const int i : region) region_pts.push_back(pts[i]);
+  for (const int i : region)
+    region_pts.push_back(pts[i]);
   double sigma = config.noise_sigma;
   if (sigma < 0.0) {
     const double estimate = estimateNoiseSigma(region_pts, line, slices, h);
     sigma = estimate > 0.0 ? estimate : 0.0;
   }
   trunk.noise_sigma = sigma;
+  const double scatter =
+      config.ours_correct_noise_bias ? std::hypot(sigma, config.beam_spread) : 0.0;
+  trunk.scatter = scatter;
   double circle_threshold = config.circle_threshold, cylinder_threshold = config.cylinder_threshold;
   if (config.ours_derive_parameters) {
     circle_threshold = std::max(circle_threshold, 2.5 * sigma);
     cylinder_threshold = std::max(cylinder_threshold, 2.5 * sigma);
   }
-  if (config.ours_constrain_ransac || config.ours_derive_parameters || config.ours_correct_noise_bias) {
+  if (config.ours_constrain_ransac || config.ours_derive_parameters ||
+      config.ours_correct_noise_bias) {
     const auto expected = expectedRadii(slices);
     slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
-                           config.ours_constrain_ransac ? &expected : nullptr, config.radius_continuity,
-                           config.ours_correct_noise_bias ? sigma : 0.0, config);
-
+                           config.ours_constrain_ransac ? &expected : nullptr,
+                           config.radius_continuity, scatter, config);
   }
   trunk.slices = slices;
   trunk.centerline = line;
   double top = 0.0;
   for (const auto& sl : slices) {
-    if (sl.points >= MIN_SLICE_POINTS) top = std::max(top, sl.s0 + h);
+    if (sl.points >= MIN_SLICE_POINTS)
+      top = std::max(top, sl.s0 + h);
   }
   auto cuts = disturbancePartitions(slices, h, config.disturbance_zero_run, top);
   // Short segments join their upper neighbour: a cylinder needs some length to be measured.
   std::vector<double> merged{cuts.front()};
   for (std::size_t i = 1; i < cuts.size(); ++i) {
-    if (cuts[i] - merged.back() >= config.min_segment_length || i + 1 == cuts.size()) merged.push_back(cuts[i]);
+    if (cuts[i] - merged.back() >= config.min_segment_length || i + 1 == cuts.size())
+      merged.push_back(cuts[i]);
   }
   if (merged.size() >= 3 && merged.back() - merged[merged.size() - 2] < config.min_segment_length) {
     merged.erase(merged.end() - 2);
@@ -439,27 +493,34 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   for (std::size_t i = 1; i < merged.size(); ++i) {
     const double a = final_cuts.back(), b = merged[i];
     if (b - a >= 2.0 * config.min_segment_length) {
-      if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices, cylinder_threshold, sigma, config, stream++)) {
+      if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices,
+                                      cylinder_threshold, scatter, config, stream++)) {
         const int bins = std::max(2, static_cast<int>((b - a) / h));
         std::vector<int> in(bins, 0), all(bins, 0);
         for (std::size_t k = 0; k < region.size(); ++k) {
-          if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance) continue;
+          if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance)
+            continue;
           const int bin = std::min(bins - 1, static_cast<int>((s[k] - a) / (b - a) * bins));
           ++all[bin];
-          in[bin] += std::abs(axisDistance(*cyl, pts[region[k]]) - cyl->radius) < cylinder_threshold;
+          in[bin] +=
+              std::abs(axisDistance(*cyl, pts[region[k]]) - cyl->radius) < cylinder_threshold;
         }
         double jump = 0.0;
         int at = -1;
         for (int k = 1; k < bins; ++k) {
-          if (all[k] < MIN_SLICE_POINTS || all[k - 1] < MIN_SLICE_POINTS) continue;
-          const double j = std::abs(static_cast<double>(in[k]) / all[k] - static_cast<double>(in[k - 1]) / all[k - 1]);
+          if (all[k] < MIN_SLICE_POINTS || all[k - 1] < MIN_SLICE_POINTS)
+            continue;
+          const double j = std::abs(static_cast<double>(in[k]) / all[k] -
+                                    static_cast<double>(in[k - 1]) / all[k - 1]);
           const double cut = a + (b - a) * k / bins;
-          if (j > jump && cut - a >= config.min_segment_length && b - cut >= config.min_segment_length) {
+          if (j > jump && cut - a >= config.min_segment_length &&
+              b - cut >= config.min_segment_length) {
             jump = j;
             at = k;
           }
         }
-        if (at > 0 && jump > config.curvature_jump) final_cuts.push_back(a + (b - a) * at / bins);
+        if (at > 0 && jump > config.curvature_jump)
+          final_cuts.push_back(a + (b - a) * at / bins);
       }
     }
     final_cuts.push_back(b);
@@ -467,12 +528,14 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   trunk.partitions = final_cuts;
   for (std::size_t i = 0; i + 1 < final_cuts.size(); ++i) {
     const double a = final_cuts[i], b = final_cuts[i + 1];
-    if (auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices, cylinder_threshold, sigma, config, 1000 + i)) {
+    if (auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices, cylinder_threshold,
+                              scatter, config, 1000 + i)) {
       trunk.cylinders.push_back(*cyl);
       trunk.cylinder_ranges.emplace_back(a, b);
     }
   }
-  if (trunk.cylinders.empty()) throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
+  if (trunk.cylinders.empty())
+    throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
   return trunk;
 }
 

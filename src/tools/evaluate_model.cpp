@@ -12,9 +12,11 @@ using namespace dormant_tree_modeling;
 int main(int argc, char** argv) {
   std::vector<std::string> models, truths;
   po::options_description desc(
-      "Usage: evaluate_model --model model.json --truth truth.json [--model M2 --truth T2 ...] [--json]\n"
+      "Usage: evaluate_model --model model.json --truth truth.json [--model M2 --truth T2 ...] "
+      "[--json]\n"
       "Prints PB, IPB, FP rate, FN rate, F1, branch and trunk diameter MAE, coverage, runtime");
-  desc.add_options()("help,h", "this help")("model,m", po::value(&models)->composing(), "model JSON (repeatable)")(
+  desc.add_options()("help,h", "this help")("model,m", po::value(&models)->composing(),
+                                            "model JSON (repeatable)")(
       "truth,t", po::value(&truths)->composing(), "truth JSON, paired in order with --model")(
       "json", "machine-readable output");
   try {
@@ -33,10 +35,12 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < models.size(); ++i) {
       auto s = evaluation::evaluate(io::readModelFile(models[i]), io::readTruthFile(truths[i]));
       s.name = models[i];
-      if (s.name.size() > 28) s.name = "..." + s.name.substr(s.name.size() - 25);
+      if (s.name.size() > 28)
+        s.name = "..." + s.name.substr(s.name.size() - 25);
       scores.push_back(s);
     }
-    std::cout << (vm.count("json") ? evaluation::scoresToJson(scores) : evaluation::formatTable(scores));
+    std::cout << (vm.count("json") ? evaluation::scoresToJson(scores)
+                                   : evaluation::formatTable(scores));
     return 0;
   } catch (const po::error& e) {
     std::cerr << "evaluate_model: " << e.what() << "\n";

@@ -59,8 +59,10 @@ int main(int argc, char** argv) {
       std::cerr << "tree_model: INPUT and --output are required\n" << desc << "\n";
       return 2;
     }
-    modeling::ModelerConfig config = vm.count("paper") ? modeling::ModelerConfig::paper() : modeling::ModelerConfig{};
-    if (!params.empty()) config = modeling::loadModelerConfig(params);
+    modeling::ModelerConfig config =
+        vm.count("paper") ? modeling::ModelerConfig::paper() : modeling::ModelerConfig{};
+    if (!params.empty())
+      config = modeling::loadModelerConfig(params);
     const modeling::TreeModeler modeler(config);
     const auto cloud = io::readCloud(input);
     if (cloud.dropped_non_finite > 0) {
@@ -68,17 +70,19 @@ int main(int argc, char** argv) {
     }
     const auto result = modeler.model(*cloud.cloud);
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));
-    if (!csv.empty()) io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));
+    if (!csv.empty())
+      io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));
     if (vm.count("verbose")) {
       std::cerr << "tree_model: " << result.points.size() << " points modeled, noise sigma "
-                << 1000.0 * result.noise_sigma << " mm, e_t " << 1000.0 * result.split_error << " mm, "
-                << result.clusters << " clusters (" << result.trunk_clusters << " trunk, "
-                << result.primary_clusters << " primary)\n";
-      for (const auto& t : result.timings) std::cerr << "  " << t.first << ": " << t.second << " s\n";
+                << 1000.0 * result.noise_sigma << " mm, e_t " << 1000.0 * result.split_error
+                << " mm, " << result.clusters << " clusters (" << result.trunk_clusters
+                << " trunk, " << result.primary_clusters << " primary)\n";
+      for (const auto& t : result.timings)
+        std::cerr << "  " << t.first << ": " << t.second << " s\n";
     }
     std::cout << "tree_model: " << result.model.trunk.size() << " trunk cylinders, "
-              << result.model.primary_branches.size() << " primary branches in " << result.model.runtime_s
-              << " s -> " << output << "\n";
+              << result.model.primary_branches.size() << " primary branches in "
+              << result.model.runtime_s << " s -> " << output << "\n";
     return 0;
   } catch (const po::error& e) {
     std::cerr << "tree_model: " << e.what() << "\n";

@@ -12,9 +12,9 @@ namespace evaluation {
 /// @brief The point of a polyline nearest to a query.
 struct PolylinePoint {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  double distance = 0.0;     ///< from the query, m
-  double arc_length = 0.0;   ///< from the polyline's start, m
-  double diameter = 0.0;     ///< interpolated, m
+  double distance = 0.0;                                 ///< from the query, m
+  double arc_length = 0.0;                               ///< from the polyline's start, m
+  double diameter = 0.0;                                 ///< interpolated, m
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  ///< unit, of the segment holding it
 };
 
@@ -23,14 +23,14 @@ PolylinePoint closestPoint(const Polyline& line, const Eigen::Vector3d& q);
 
 /// @brief Matching bounds of docs/evaluation.md.
 struct MatchBounds {
-  double min_distance = 0.03;  ///< e <= max(this, D(q))
+  double min_distance = 0.03;   ///< e <= max(this, D(q))
   double max_arc_length = 1.0;  ///< s <= this
   double max_angle_deg = 30.0;  ///< axis vs polyline direction, sign ignored
 };
 
 /// @brief Whether a detection can match a polyline, and its e.
-bool canMatch(const modeling::CylinderModel& detection, const Polyline& line, const MatchBounds& bounds,
-              double* e = nullptr, PolylinePoint* at = nullptr);
+bool canMatch(const modeling::CylinderModel& detection, const Polyline& line,
+              const MatchBounds& bounds, double* e = nullptr, PolylinePoint* at = nullptr);
 
 /// @brief Minimum-cost one-to-one assignment (Hungarian algorithm) on a rows x cols matrix;
 /// returns, per row, the assigned column or -1. Pairs with cost >= `forbidden` are never kept.
@@ -48,20 +48,21 @@ struct BranchMatch {
 /// @brief The evaluation row of docs/evaluation.md for one tree.
 struct TreeScore {
   std::string name;
-  int pb = 0;       ///< true primary branches
-  int ipb = 0;      ///< detections, ignored ones excluded
+  int pb = 0;   ///< true primary branches
+  int ipb = 0;  ///< detections, ignored ones excluded
   int tp = 0, fp = 0, fn = 0, ignored = 0;
   double fp_rate = 0.0, fn_rate = 0.0, f1 = 0.0;
   double branch_mae = 0.0, branch_rmse = 0.0, branch_bias = 0.0;  ///< m, over TP pairs
-  double trunk_mae = 0.0;         ///< m, length-weighted
-  double centerline_error = 0.0;  ///< m
-  double coverage = 0.0;          ///< 0..1
+  double trunk_mae = 0.0;                                         ///< m, length-weighted
+  double centerline_error = 0.0;                                  ///< m
+  double coverage = 0.0;                                          ///< 0..1
   double runtime_s = 0.0;
   std::vector<BranchMatch> matches;
 };
 
 /// @brief Score a model against ground truth exactly as docs/evaluation.md defines.
-TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth, const MatchBounds& bounds = {});
+TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
+                   const MatchBounds& bounds = {});
 
 /// @brief A Table-3-style text table: one row per tree and, for more than one, a mean row.
 std::string formatTable(const std::vector<TreeScore>& scores);

@@ -12,7 +12,8 @@ namespace io {
 /// role,id,parent_id,center_x,center_y,center_z,axis_x,axis_y,axis_z,diameter_m,length_m,
 /// num_points,inlier_ratio,attachment_height_m,angle_to_trunk_deg,trunk_diameter_m,
 /// diameter_ratio,prune. Branch-only columns are empty for trunk rows.
-std::string cylindersToCsv(const modeling::TreeModel& model, const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
+std::string cylindersToCsv(const modeling::TreeModel& model,
+                           const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
 
 }  // namespace io
 }  // namespace dormant_tree_modeling

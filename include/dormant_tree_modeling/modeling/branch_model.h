@@ -11,9 +11,9 @@ namespace modeling {
 
 /// @brief One primary branch found on the trunk.
 struct BranchFit {
-  Cylinder cylinder;         ///< axis points away from the trunk
-  int trunk_segment = 0;     ///< index into TrunkModel::cylinders
-  std::vector<int> inliers;  ///< indices into the modeled cloud
+  Cylinder cylinder;                                     ///< axis points away from the trunk
+  int trunk_segment = 0;                                 ///< index into TrunkModel::cylinders
+  std::vector<int> inliers;                              ///< indices into the modeled cloud
   Eigen::Vector3d attachment = Eigen::Vector3d::Zero();  ///< on the trunk axis
 };
 
@@ -25,8 +25,8 @@ struct BranchFit {
 /// With config.ours_constrain_ransac a branch must leave the trunk surface: its axis points
 /// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
 /// crossing near the trunk do not), and duplicates of one branch are merged.
-std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk, const std::vector<int>& region,
-                                     const ModelerConfig& config);
+std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
+                                     const std::vector<int>& region, const ModelerConfig& config);
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

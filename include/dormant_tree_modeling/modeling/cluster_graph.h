@@ -38,7 +38,8 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
 /// @brief Step 4: adjacency lists of the bidirectional interface test: P_i and P_k are
 /// connected when, from both sides, the point p nearest to the other cluster has between n_L
 /// and n_H of its N nearest neighbours (in the whole cloud) in the other cluster.
-std::vector<std::vector<int>> connectClusters(const Points& pts, const std::vector<Cluster>& clusters,
+std::vector<std::vector<int>> connectClusters(const Points& pts,
+                                              const std::vector<Cluster>& clusters,
                                               const ModelerConfig& config);
 
 /// @brief Result of step 5 and 6.
@@ -54,7 +55,8 @@ struct TrunkPath {
 /// cylinder pieces) the one whose walk gathers the most clusters wins: a post has no branches.
 
 /// Step 6: primary-branch clusters.
-TrunkPath findTrunkPath(const std::vector<Cluster>& clusters, const std::vector<std::vector<int>>& adjacency,
+TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
+                        const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config);
 
 }  // namespace modeling

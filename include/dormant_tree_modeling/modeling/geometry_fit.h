@@ -24,9 +24,9 @@ struct Cylinder {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
   double radius = 0.0;
   double length = 0.0;
-  double rms = 0.0;              ///< RMS of |distance to axis - radius| over the fitted points
-  double mean_abs_error = 0.0;   ///< mean |distance to axis - radius|
-  double mean_sq_distance = 0.0; ///< mean squared distance to the axis (for the noise correction)
+  double rms = 0.0;               ///< RMS of |distance to axis - radius| over the fitted points
+  double mean_abs_error = 0.0;    ///< mean |distance to axis - radius|
+  double mean_sq_distance = 0.0;  ///< mean squared distance to the axis (for the noise correction)
 };
 
 /// @brief Distance of p to the infinite axis of c.
@@ -70,7 +70,7 @@ Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid = nul
 struct CylinderRansacOptions {
   double threshold = 0.01;  ///< m, inlier band |d - r|
   int circle_iterations = 150;
-  int axis_candidates = 12;       ///< axis directions tried around the guess
+  int axis_candidates = 12;         ///< axis directions tried around the guess
   double max_axis_deviation = 0.5;  ///< rad, how far candidates may leave the guess
   double min_radius = 0.002;
   double max_radius = 0.5;
@@ -97,10 +97,13 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 /// @brief Cylinder for thin, noisy branches, where a RANSAC circle band would be wider than the
 /// radius: a RANSAC line (band: max_radius + 2.5 sigma) refined by PCA on its inliers, then a
 /// least-squares cylinder on them when it agrees with the line (within 20 deg, radius within
-/// bounds), and the radius from the noise-corrected second moment sqrt(mean d^2 - sigma^2).
+/// bounds), and the radius from the scatter-corrected second moment sqrt(mean d^2 - scatter^2).
+/// @param sigma range noise: sets the bands (m)
+/// @param scatter total scatter removed from the moment (noise and beam spread; 0: none) (m)
 /// @param inliers set to the indices of the points used for the radius
-std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess, double sigma,
-                                        double max_radius, std::uint64_t seed, std::vector<int>* inliers = nullptr);
+std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                        double sigma, double scatter, double max_radius,
+                                        std::uint64_t seed, std::vector<int>* inliers = nullptr);
 
 /// @brief Deterministic k-means with k-means++ seeding from `seed`.
 /// @param pts points

@@ -14,15 +14,15 @@ struct ModelerConfig {
   // --- Preprocessing -------------------------------------------------------------------
   double voxel_size = 0.004;  ///< downsampling grid; 0 keeps every point
   // --- Algorithm 2: clusters, graph, trunk path ---------------------------------------
-  int cluster_points = 3000;      ///< N_c = points / cluster_points (paper: ~3000 per cluster)
-  double split_error = 0.004;     ///< e_t: mean |d - r| of a cluster's cylinder fit that splits it
-  double merge_distance = 0.05;   ///< d_t: clusters whose centres are closer merge
-  int min_cluster_points = 40;    ///< clusters are not split below twice this
-  int graph_neighbors = 30;       ///< N: nearest neighbours of the interface point
-  double n_low = 0.3;             ///< n_L: lower bound of the neighbour share for an edge
-  double n_high = 0.7;            ///< n_H: upper bound
-  double psi_t = 72.0;            ///< psi_T: stop the trunk path at edges this far from vertical
-  int kmeans_iterations = 30;     ///< Lloyd iterations at most
+  int cluster_points = 3000;     ///< N_c = points / cluster_points (paper: ~3000 per cluster)
+  double split_error = 0.004;    ///< e_t: mean |d - r| of a cluster's cylinder fit that splits it
+  double merge_distance = 0.05;  ///< d_t: clusters whose centres are closer merge
+  int min_cluster_points = 40;   ///< clusters are not split below twice this
+  int graph_neighbors = 30;      ///< N: nearest neighbours of the interface point
+  double n_low = 0.3;            ///< n_L: lower bound of the neighbour share for an edge
+  double n_high = 0.7;           ///< n_H: upper bound
+  double psi_t = 72.0;           ///< psi_T: stop the trunk path at edges this far from vertical
+  int kmeans_iterations = 30;    ///< Lloyd iterations at most
   // --- Algorithm 3: slices, partitions, cylinders, branches ---------------------------
   double slice_height = 0.05;         ///< Delta Z (paper: 3-7 cm)
   double circle_threshold = 0.008;    ///< RANSAC inlier band of the slice circles
@@ -31,29 +31,40 @@ struct ModelerConfig {
   int disturbance_zero_run = 2;       ///< slices of flat eta before a rise counts as a partition
   double curvature_jump = 0.25;       ///< outlier-share jump along a segment that splits it
   double min_segment_length = 0.15;   ///< trunk segments are not split below this
-  double branch_cluster_tolerance = 0.025;  ///< Euclidean clustering of segment outliers
+  double branch_cluster_tolerance = 0.012;  ///< Euclidean clustering of branch candidates
   int branch_min_points = 25;               ///< smaller clusters are not branches
   double branch_fit_length = 0.30;  ///< a branch cylinder covers this much from the trunk surface
   // --- Past the paper (each switchable) ----------------------------------------------
   bool ours_derive_parameters = true;  ///< e_t, thresholds from the estimated noise and density
   bool ours_remove_clutter = true;     ///< floating pixels, ground, wires before modelling
   bool ours_constrain_ransac = true;   ///< trunk near vertical, radius continuity, branches radial
-  bool ours_follow_diameter = true;    ///< trunk top followed by diameter, not the most vertical edge
-  bool ours_correct_noise_bias = true;  ///< radius sqrt(mean d^2 - sigma^2) instead of the plain fit
+  bool ours_follow_diameter = true;  ///< trunk top followed by diameter, not the most vertical edge
+  bool ours_correct_noise_bias =
+      true;                       ///< radius sqrt(mean d^2 - sigma^2) instead of the plain fit
   bool ours_branch_shell = true;  ///< branch candidates from all points around the trunk, validated
   double noise_sigma = -1.0;      ///< range noise (m); negative: estimated from the trunk
-  double trunk_max_tilt = 30.0;   ///< trunk cylinders' axes within this of vertical
-  double radius_continuity = 0.35;  ///< a trunk segment's radius within this share of its neighbour's
-  double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
-  double branch_axis_gap = 0.10;  ///< branch axis must pass this close to the trunk surface
-  double branch_inner_gap = 0.05;  ///< shell branch candidates start this far out from the trunk surface
+  /// Lateral scatter of returns (m, 1 sigma) from the beam footprint: a partly hit beam reports
+  /// its range along the beam centre, so thin objects look wider. Subtracted in quadrature with
+  /// the range noise from every radius. Default: 0.63 x the LMS111 beam radius at the 2 m
+  /// working range (8 mm + 15 mrad, SICK LMS1xx manual 3.6.2), calibrated on the sensor model;
+  /// re-calibrate against calipers in the field, 0 for an ideal beam.
+  double beam_spread = 0.012;
 
-  double floating_radius = 0.02;  ///< floating-pixel removal: neighbourhood radius
+  double trunk_max_tilt = 30.0;  ///< trunk cylinders' axes within this of vertical
+  double radius_continuity =
+      0.35;  ///< a trunk segment's radius within this share of its neighbour's
+  double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
+  double branch_axis_gap = 0.10;          ///< branch axis must pass this close to the trunk surface
+  double branch_inner_gap =
+      0.05;  ///< shell branch candidates start this far out from the trunk surface
+
+  double floating_radius = 0.02;   ///< floating-pixel removal: neighbourhood radius
   int floating_min_neighbors = 4;  ///< fewer neighbours within the radius: a floating pixel
   double wire_min_length = 1.2;    ///< straight thin horizontal runs this long are wires
   // --- Measurements ---------------------------------------------------------------------
-  double prune_ratio = 0.5;  ///< branch / trunk diameter above which a branch is a pruning candidate
-  std::uint64_t seed = 1;    ///< k-means++ and RANSAC streams: equal inputs give equal models
+  double prune_ratio =
+      0.5;                 ///< branch / trunk diameter above which a branch is a pruning candidate
+  std::uint64_t seed = 1;  ///< k-means++ and RANSAC streams: equal inputs give equal models
 
   /// @brief The paper's method alone: every `ours_*` switch off.
   static ModelerConfig paper();

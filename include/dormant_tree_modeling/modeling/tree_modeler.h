@@ -22,9 +22,9 @@ struct ModelResult {
   Points points;                    ///< the cloud the model was computed from (preprocessed)
   std::vector<PointClass> classes;  ///< one per entry of `points`
   PreprocessStats preprocess;
-  double noise_sigma = 0.0;         ///< range noise estimate used (m)
-  double split_error = 0.0;         ///< e_t used (m)
-  int clusters = 0;                 ///< after split and merge
+  double noise_sigma = 0.0;  ///< range noise estimate used (m)
+  double split_error = 0.0;  ///< e_t used (m)
+  int clusters = 0;          ///< after split and merge
   int trunk_clusters = 0;
   int primary_clusters = 0;
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds

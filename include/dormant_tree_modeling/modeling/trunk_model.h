@@ -33,10 +33,10 @@ class Centerline {
 
 /// @brief One slice of Algorithm 3 step 1.
 struct Slice {
-  double s0 = 0.0;                 ///< arc length of the slice's lower bound
+  double s0 = 0.0;  ///< arc length of the slice's lower bound
   int points = 0;
-  int outliers = 0;                ///< eta: points off the slice's RANSAC circle
-  double outlier_share = 0.0;      ///< outliers / points
+  int outliers = 0;            ///< eta: points off the slice's RANSAC circle
+  double outlier_share = 0.0;  ///< outliers / points
   bool has_circle = false;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< circle centre in 3-D
   double radius = 0.0;
@@ -45,22 +45,24 @@ struct Slice {
   double corrected_radius = 0.0;
 };
 
-
 /// @brief The trunk as Algorithm 3 models it.
 struct TrunkModel {
-  Centerline centerline;           ///< refined by the slice circles
+  Centerline centerline;  ///< refined by the slice circles
   std::vector<Slice> slices;
-  std::vector<double> partitions;  ///< arc lengths of the segment bounds, first 0, last = top
-  std::vector<Cylinder> cylinders; ///< one per segment, bottom to top (failed fits left out)
+  std::vector<double> partitions;   ///< arc lengths of the segment bounds, first 0, last = top
+  std::vector<Cylinder> cylinders;  ///< one per segment, bottom to top (failed fits left out)
   std::vector<std::pair<double, double>> cylinder_ranges;  ///< arc-length range of each cylinder
-  double noise_sigma = 0.0;        ///< range noise used for the bias correction (m)
+  double noise_sigma = 0.0;                                ///< range noise estimate (m)
+  /// Total scatter removed from radii: sqrt(noise_sigma^2 + beam_spread^2) when the bias
+  /// correction is on, else 0 (m).
+  double scatter = 0.0;
 };
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
 /// parts: 1.4826 MAD of the radial residuals, x sqrt(3/2) because a return's radial residual
 /// carries on average 2/3 of its range variance. Nothing when too few slices qualify.
-double estimateNoiseSigma(const Points& pts, const Centerline& line, const std::vector<Slice>& slices,
-                          double slice_height);
+double estimateNoiseSigma(const Points& pts, const Centerline& line,
+                          const std::vector<Slice>& slices, double slice_height);
 
 /// @brief Partition arc lengths from eta (step 2): where a positive derivative follows a run of
 /// at least `zero_run` near-zero derivatives. Includes 0 and the top.
@@ -95,7 +97,6 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
                       const ModelerConfig& config);
-
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

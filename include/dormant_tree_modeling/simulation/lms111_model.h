@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "dormant_tree_modeling/simulation/primitives.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/simulation/primitives.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
 
 namespace dormant_tree_modeling {
