@@ -52,9 +52,17 @@ void updateCluster(const Points& pts, Cluster& c) {
   c.error = c.fit ? c.fit->mean_abs_error : std::numeric_limits<double>::infinity();
 }
 
-std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config) {
-  const int k =
-      std::max(1, static_cast<int>(pts.size() / static_cast<std::size_t>(config.cluster_points)));
+std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config,
+                                     double spacing) {
+  std::size_t per_cluster = static_cast<std::size_t>(config.cluster_points);
+  if (config.ours_derive_parameters && spacing > 0.0) {
+    // N_c from density: a cluster about 15 cm across, whatever the scanner's point spacing
+    // (the paper's 3000 points fit its density, not a sparse terrestrial scan).
+    const double by_density = (0.15 / spacing) * (0.15 / spacing);
+    per_cluster = static_cast<std::size_t>(
+        std::clamp(by_density, 30.0, static_cast<double>(config.cluster_points)));
+  }
+  const int k = std::max(1, static_cast<int>(pts.size() / per_cluster));
   const auto labels = kMeans(pts, k, config.kmeans_iterations, config.seed);
   int count = 0;
   for (const int l : labels)
@@ -77,7 +85,8 @@ double derivedSplitError(const std::vector<Cluster>& clusters, double configured
     return configured;
   const std::size_t q = errors.size() / 4;
   std::nth_element(errors.begin(), errors.begin() + q, errors.end());
-  return std::max(configured, 1.5 * errors[q]);
+  // Capped: where every initial cluster spans junctions, the quartile says nothing of the noise.
+  return std::clamp(1.5 * errors[q], configured, 5.0 * configured);
 }
 
 std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clusters, double e_t,

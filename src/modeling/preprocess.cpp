@@ -180,6 +180,23 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
 
 }  // namespace
 
+double medianSpacing(const Points& pts) {
+  if (pts.size() < 2)
+    return 0.0;
+  const PointIndex index(pts);
+  const std::size_t stride = std::max<std::size_t>(1, pts.size() / 2000);
+  std::vector<double> d;
+  for (std::size_t i = 0; i < pts.size(); i += stride) {
+    const auto nn = index.nearest(pts[i], 2);
+    if (nn.size() == 2)
+      d.push_back((pts[nn[1]] - pts[i]).norm());
+  }
+  if (d.empty())
+    return 0.0;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
 Points voxelDownsample(const Points& pts, double voxel) {
   if (voxel <= 0.0)
     return pts;
@@ -215,7 +232,15 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
   Points out = voxelDownsample(pts, config.voxel_size);
   s.after_voxel = out.size();
   if (config.ours_remove_clutter) {
-    const auto mask = floatingMask(out, config.floating_radius, config.floating_min_neighbors);
+    double radius = config.floating_radius;
+    if (config.ours_derive_parameters) {
+      // Sparse clouds (terrestrial scans of whole trees, a few cm between returns) would lose
+      // everything to a fixed radius: scale it with the median nearest-neighbour spacing.
+      radius = std::max(radius, 3.0 * medianSpacing(out));
+    }
+    s.floating_radius = radius;
+    const auto mask = floatingMask(out, radius, config.floating_min_neighbors);
+
     Points kept;
     for (std::size_t i = 0; i < out.size(); ++i) {
       if (!mask[i])

@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <optional>
 
@@ -106,6 +104,11 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
     TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
     if (tracked.centers.size() < 3)
       continue;
+    // And down to the ground: where the first cluster begins is an accident of k-means.
+    const TrackedTrunk down = trackTrunk(pts, index, tracked.centers.front(), -up,
+                                         tracked.radii.front(), threshold, config, 2);
+    tracked.centers.insert(tracked.centers.begin(), down.centers.rbegin(), down.centers.rend());
+    tracked.radii.insert(tracked.radii.begin(), down.radii.rbegin(), down.radii.rend());
     double shell = 0.0;
     for (std::size_t k = 0; k < tracked.centers.size(); k += 2) {
       const double r = tracked.radii[k];
@@ -165,7 +168,8 @@ ModelResult TreeModeler::model(const Points& input) const {
   }
 
   // Algorithm 2.
-  auto clusters = initialClusters(pts, config_);
+  auto clusters = initialClusters(pts, config_, medianSpacing(pts));
+
   watch.lap("kmeans");
   result.split_error = config_.ours_derive_parameters
                            ? derivedSplitError(clusters, config_.split_error)

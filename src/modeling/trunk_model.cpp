@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
@@ -89,11 +87,32 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
 
     o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
     std::vector<int> inliers;
-    const auto circle = ransacCircle(plane, o, &inliers);
+    auto circle = ransacCircle(plane, o, &inliers);
     sl.outliers = sl.points - static_cast<int>(inliers.size());
     sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
+    if (circle && threshold / 2.5 > 0.2 * circle->radius) {
+      // Noise comparable to the radius: the circle band covers the whole disc and its centre
+      // drifts towards branch bases; the disc's trimmed mean is the better centre.
+      Eigen::Vector2d centre = circle->center;
+      const double window = circle->radius + threshold;
+      for (int round = 0; round < 4; ++round) {
+        Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+        int n_in = 0;
+        for (const auto& q : plane) {
+          if ((q - centre).norm() < window) {
+            sum += q;
+            ++n_in;
+          }
+        }
+        if (n_in == 0)
+          break;
+        centre = sum / n_in;
+      }
+      circle->center = centre;
+    }
     if (circle && inliers.size() >= MIN_SLICE_POINTS / 2) {
       sl.has_circle = true;
+
       sl.radius = circle->radius;
       sl.center = origin + circle->center.x() * u + circle->center.y() * v;
       sl.corrected_radius = sl.radius;
@@ -344,10 +363,6 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 
     const bool ok =
         circle && inliers.size() >= MIN_SLICE_POINTS / 2 && circle->center.norm() < r + 0.02;
-    if (getenv("DTM_DEBUG_TRACK"))
-      fprintf(stderr, "  step z=%.2f n=%zu r=%.3f circle=%d cr=%.3f inl=%zu off=%.3f\n",
-              predicted.z(), plane.size(), r, circle ? 1 : 0, circle ? circle->radius : 0.0,
-              inliers.size(), circle ? circle->center.norm() : 0.0);
     if (!ok) {
       ++misses;
       c = predicted;

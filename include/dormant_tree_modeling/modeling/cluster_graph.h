@@ -20,8 +20,12 @@ struct Cluster {
 /// @brief Recompute centroid, cylinder fit and error of a cluster.
 void updateCluster(const Points& pts, Cluster& cluster);
 
-/// @brief Step 1: k-means into N_c = |pts| / cluster_points clusters (k-means++ seeding).
-std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config);
+/// @brief Step 1: k-means into N_c = |pts| / cluster_points clusters (k-means++ seeding). With
+/// config.ours_derive_parameters the points per cluster follow the density instead:
+/// (0.15 m / spacing)^2, at most cluster_points.
+/// @param spacing median nearest-neighbour distance of pts (m), 0 when unknown
+std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config,
+                                     double spacing = 0.0);
 
 /// @brief e_t derived from the data: 1.5 x the 25th percentile of the clusters' fit errors
 /// (clean cylinder pieces sit at the noise floor), never below the configured e_t.

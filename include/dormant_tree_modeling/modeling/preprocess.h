@@ -13,7 +13,11 @@ struct PreprocessStats {
   std::size_t floating = 0;  ///< isolated returns and mixed pixels (Eq. 1's targets)
   std::size_t ground = 0;
   std::size_t wires = 0;
+  double floating_radius = 0.0;  ///< neighbourhood radius used for floating pixels (m)
 };
+
+/// @brief Median distance from a point to its nearest neighbour (on a sample of the points).
+double medianSpacing(const Points& pts);
 
 /// @brief Voxel-grid downsampling: the centroid of the points in each occupied voxel, in a
 /// deterministic order (sorted by voxel key).

@@ -1,0 +1,154 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+Points cylinderPoints(const Eigen::Vector3d& base, const Eigen::Vector3d& axis, double r,
+                      double length, int n, double noise, std::uint64_t seed) {
+  Rng rng(seed);
+  const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
+  Points pts;
+  for (int i = 0; i < n; ++i) {
+    const double t = rng.uniform(0.0, length), phi = rng.uniform(0.0, 2.0 * M_PI);
+    const Eigen::Vector3d radial = std::cos(phi) * u + std::sin(phi) * v;
+    pts.push_back(base + t * a + (r + rng.normal(0.0, noise)) * radial);
+  }
+  return pts;
+}
+
+TEST(Circle, ThroughThreePointsAndCollinear) {
+  const auto c = circleThrough({1, 0}, {0, 1}, {-1, 0});
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->center.norm(), 0.0, 1e-12);
+  EXPECT_NEAR(c->radius, 1.0, 1e-12);
+  EXPECT_FALSE(circleThrough({0, 0}, {1, 1}, {2, 2}));
+}
+
+TEST(Circle, LeastSquaresIsExactOnExactPoints) {
+  Points2 pts;
+  for (int i = 0; i < 12; ++i)
+    pts.emplace_back(2.0 + 0.3 * std::cos(i * 0.5), -1.0 + 0.3 * std::sin(i * 0.5));
+  const auto c = fitCircle(pts);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->center.x(), 2.0, 1e-9);
+  EXPECT_NEAR(c->center.y(), -1.0, 1e-9);
+  EXPECT_NEAR(c->radius, 0.3, 1e-9);
+}
+
+TEST(Circle, RansacIgnoresOutliersAndRespectsBounds) {
+  Rng rng(3);
+  Points2 pts;
+  for (int i = 0; i < 200; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI);
+    pts.emplace_back(0.05 * std::cos(a) + rng.normal(0.0, 0.001),
+                     0.05 * std::sin(a) + rng.normal(0.0, 0.001));
+  }
+  for (int i = 0; i < 100; ++i)
+    pts.emplace_back(rng.uniform(0.1, 0.4), rng.uniform(-0.2, 0.2));  // a branch
+  CircleRansacOptions o;
+  o.threshold = 0.004;
+  std::vector<int> inliers;
+  const auto c = ransacCircle(pts, o, &inliers);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->radius, 0.05, 0.002);
+  EXPECT_NEAR(c->center.norm(), 0.0, 0.002);
+  EXPECT_GE(inliers.size(), 195u);
+  EXPECT_LE(inliers.size(), 215u);
+  o.max_radius = 0.03;  // no circle of that size fits the ring
+  const auto small = ransacCircle(pts, o);
+  if (small)
+    EXPECT_LE(small->radius, 0.03);
+}
+
+TEST(Cylinder, LeastSquaresRecoversAnInclinedCylinder) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
+  const Points pts = cylinderPoints({1, 2, 0}, axis, 0.04, 0.5, 400, 0.0, 1);
+  const auto c = fitCylinder(pts, Eigen::Vector3d::UnitZ());
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->radius, 0.04, 1e-6);
+  EXPECT_NEAR(std::abs(c->axis.dot(axis)), 1.0, 1e-8);
+  EXPECT_GT(c->axis.z(), 0.0);  // keeps the sign of the guess
+  EXPECT_NEAR(c->length, 0.5, 0.02);
+  const Eigen::Vector3d mid = Eigen::Vector3d(1, 2, 0) + 0.25 * axis;
+  EXPECT_LT((c->center - mid).norm(), 0.02);
+}
+
+TEST(Cylinder, NoisyFitIsBiasedUpAndTheCorrectionRemovesIt) {
+  const double r = 0.02, sigma = 0.006;
+  const Points pts = cylinderPoints({0, 0, 0}, Eigen::Vector3d::UnitZ(), r, 0.3, 4000, sigma, 2);
+  const auto c = fitCylinder(pts, Eigen::Vector3d::UnitZ());
+  ASSERT_TRUE(c);
+  const double corrected = noiseCorrectedRadius(*c, pts, sigma, 4.0 * sigma, 0.001);
+  EXPECT_NEAR(corrected, r, 0.0008);
+  EXPECT_GT(std::sqrt(c->mean_sq_distance), r + 0.0005);  // the plain second moment is inflated
+}
+
+TEST(Cylinder, RansacWithOutliersAndAxisBounds) {
+  Points pts = cylinderPoints({0, 0, 0}, Eigen::Vector3d::UnitZ(), 0.03, 0.4, 600, 0.001, 4);
+  const Points branch =
+      cylinderPoints({0, 0, 0.2}, Eigen::Vector3d(1, 0, 0.2), 0.01, 0.3, 200, 0.001, 5);
+  pts.insert(pts.end(), branch.begin(), branch.end());
+  CylinderRansacOptions o;
+  o.threshold = 0.004;
+  o.max_axis_deviation = 0.3;
+  std::vector<int> inliers;
+  const auto c = ransacCylinder(pts, Eigen::Vector3d::UnitZ(), o, &inliers);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->radius, 0.03, 0.002);
+  EXPECT_GT(c->axis.z(), std::cos(0.05));
+  EXPECT_GE(inliers.size(), 590u);
+  EXPECT_LE(inliers.size(), 660u);
+}
+
+TEST(Cylinder, ThinNoisyBranchFromTheSecondMoment) {
+  // A 5 mm radius branch under 6 mm noise with a parallel shoot 3 cm away.
+  const Eigen::Vector3d axis(1, 0, 0.1);
+  Points pts = cylinderPoints({0, 0, 1}, axis, 0.005, 0.3, 1500, 0.006, 6);
+  const Points shoot = cylinderPoints({0.1, 0.03, 1.01}, axis, 0.002, 0.1, 150, 0.006, 7);
+  pts.insert(pts.end(), shoot.begin(), shoot.end());
+  const auto c = fitThinCylinder(pts, Eigen::Vector3d(1, 0, 0), 0.006, 0.006, 0.03, 1);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(c->radius, 0.005, 0.0015);
+  EXPECT_GT(std::abs(c->axis.dot(axis.normalized())), std::cos(3.0 * M_PI / 180.0));
+  EXPECT_GT(c->axis.x(), 0.0);
+}
+
+TEST(Cylinder, DegenerateInputsGiveNothing) {
+  EXPECT_FALSE(fitCylinder(Points{}, Eigen::Vector3d::UnitZ()));
+  EXPECT_FALSE(fitCylinder(Points(10, Eigen::Vector3d::Zero()), Eigen::Vector3d::UnitZ()));
+  EXPECT_FALSE(ransacCylinder(Points(3, Eigen::Vector3d::Ones()), Eigen::Vector3d::UnitZ(), {}));
+  EXPECT_FALSE(fitCircle(Points2{{0, 0}, {1, 1}}));
+}
+
+TEST(KMeans, DeterministicAndSeparatesBlobs) {
+  Rng rng(8);
+  Points pts;
+  for (int b = 0; b < 3; ++b) {
+    for (int i = 0; i < 100; ++i)
+      pts.emplace_back(b * 1.0 + rng.normal(0, 0.05), rng.normal(0, 0.05), 0.0);
+  }
+  const auto a = kMeans(pts, 3, 50, 42), b = kMeans(pts, 3, 50, 42);
+  EXPECT_EQ(a, b);
+  for (int blob = 0; blob < 3; ++blob) {
+    for (int i = 1; i < 100; ++i)
+      EXPECT_EQ(a[blob * 100 + i], a[blob * 100]);
+  }
+  EXPECT_NE(a[0], a[100]);
+  EXPECT_NE(a[100], a[200]);
+  EXPECT_NE(a[0], a[200]);
+  // k larger than the distinct points: every label is used, none out of range.
+  const auto few = kMeans(Points(5, Eigen::Vector3d::Ones()), 3, 10, 1);
+  for (const int l : few)
+    EXPECT_EQ(l, 0);
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

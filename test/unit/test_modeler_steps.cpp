@@ -1,0 +1,243 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numeric>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+#include "temp_dir.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+/// Points on a cylinder surface, evenly spread (a fixture, not a statistic).
+void addCylinder(Points& pts, const Eigen::Vector3d& base, const Eigen::Vector3d& axis, double r,
+                 double length, double step = 0.005) {
+  const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
+  const int rings = static_cast<int>(std::lround(length / step)),
+            around = std::max(8, static_cast<int>(2 * M_PI * r / step));
+  for (int i = 0; i <= rings; ++i) {
+    for (int k = 0; k < around; ++k) {
+      const double phi = 2.0 * M_PI * k / around;
+      pts.push_back(base + i * step * a + r * (std::cos(phi) * u + std::sin(phi) * v));
+    }
+  }
+}
+
+Cluster clusterOf(const Points& pts, int begin, int end) {
+  Cluster c;
+  c.members.resize(end - begin);
+  std::iota(c.members.begin(), c.members.end(), begin);
+  updateCluster(pts, c);
+  return c;
+}
+
+TEST(SplitMerge, ACleanCylinderStaysAndATeeIsSplit) {
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 0.3);
+  const int straight = static_cast<int>(pts.size());
+  addCylinder(pts, {1, 0, 0}, {0, 0, 1}, 0.03, 0.3);
+  addCylinder(pts, {1, 0, 0.15}, {1, 0, 0}, 0.015, 0.25);
+  ModelerConfig config;
+  std::vector<Cluster> clusters{clusterOf(pts, 0, straight),
+                                clusterOf(pts, straight, static_cast<int>(pts.size()))};
+  EXPECT_LT(clusters[0].error, 1e-4);
+  EXPECT_GT(clusters[1].error, config.split_error);
+  const auto split = splitClusters(pts, clusters, config.split_error, config);
+  int pieces_of_straight = 0, pieces_of_tee = 0;
+  for (const auto& c : split)
+    (c.members.front() < straight ? pieces_of_straight : pieces_of_tee)++;
+  EXPECT_EQ(pieces_of_straight, 1);
+  EXPECT_GE(pieces_of_tee, 2);
+  std::size_t total = 0;
+  for (const auto& c : split)
+    total += c.members.size();
+  EXPECT_EQ(total, pts.size());
+}
+
+TEST(SplitMerge, CentroidsCloserThanDtMerge) {
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 0.1);
+  const int a = static_cast<int>(pts.size());
+  addCylinder(pts, {0.02, 0, 0}, {0, 0, 1}, 0.03, 0.1);
+  const int b = static_cast<int>(pts.size());
+  addCylinder(pts, {0.5, 0, 0}, {0, 0, 1}, 0.03, 0.1);
+  std::vector<Cluster> clusters{clusterOf(pts, 0, a), clusterOf(pts, a, b),
+                                clusterOf(pts, b, static_cast<int>(pts.size()))};
+  const auto merged = mergeClusters(pts, clusters, 0.05);
+  ASSERT_EQ(merged.size(), 2u);
+  EXPECT_EQ(merged[0].members.size() + merged[1].members.size(), pts.size());
+  EXPECT_EQ(mergeClusters(pts, clusters, 0.01).size(), 3u);
+}
+
+/// A trunk in three stacked pieces, a branch on the middle one, and a far-away post.
+struct Fixture {
+  Points pts;
+  std::vector<Cluster> clusters;
+  Fixture() {
+    std::vector<int> bounds{0};
+    for (int i = 0; i < 3; ++i) {
+      addCylinder(pts, {0, 0, 0.3 * i}, {0, 0, 1}, 0.03, 0.295);  // rings 5 mm apart throughout
+      bounds.push_back(static_cast<int>(pts.size()));
+    }
+    addCylinder(pts, {0.03, 0, 0.45}, {1, 0, 0.1}, 0.01, 0.3);
+    bounds.push_back(static_cast<int>(pts.size()));
+    addCylinder(pts, {2, 0, 0}, {0, 0, 1}, 0.05, 0.8);
+    bounds.push_back(static_cast<int>(pts.size()));
+    for (std::size_t i = 0; i + 1 < bounds.size(); ++i)
+      clusters.push_back(clusterOf(pts, bounds[i], bounds[i + 1]));
+  }
+};
+
+TEST(ClusterGraph, InterfaceTestConnectsTouchingPiecesOnly) {
+  const Fixture f;
+  ModelerConfig config;
+  const auto adjacency = connectClusters(f.pts, f.clusters, config);
+  auto connected = [&](int a, int b) {
+    return std::find(adjacency[a].begin(), adjacency[a].end(), b) != adjacency[a].end();
+  };
+  EXPECT_TRUE(connected(0, 1));
+  EXPECT_TRUE(connected(1, 2));
+  EXPECT_TRUE(connected(1, 3));       // the branch leaves the middle piece
+  EXPECT_FALSE(connected(0, 2));      // not touching
+  EXPECT_TRUE(adjacency[4].empty());  // the post touches nothing
+  for (int i = 0; i < 5; ++i) {
+    for (const int k : adjacency[i])
+      EXPECT_TRUE(connected(k, i)) << "edges are bidirectional";
+  }
+}
+
+TEST(ClusterGraph, TrunkPathClimbsAndBranchesAreAdjacent) {
+  const Fixture f;
+  for (const bool ours : {false, true}) {
+    ModelerConfig config = ours ? ModelerConfig{} : ModelerConfig::paper();
+    const auto adjacency = connectClusters(f.pts, f.clusters, config);
+    const TrunkPath path = findTrunkPath(f.clusters, adjacency, config);
+    EXPECT_EQ(path.trunk, (std::vector<int>{0, 1, 2})) << (ours ? "ours" : "paper");
+    EXPECT_EQ(path.primary, (std::vector<int>{3})) << (ours ? "ours" : "paper");
+  }
+}
+
+TEST(ClusterGraph, PsiTStopsAtNearHorizontalSteps) {
+  const Fixture f;
+  ModelerConfig config = ModelerConfig::paper();
+  config.psi_t = 1.0;  // only perfectly vertical steps
+  const auto adjacency = connectClusters(f.pts, f.clusters, config);
+  EXPECT_EQ(findTrunkPath(f.clusters, adjacency, config).trunk.size(),
+            3u);  // the stack is exactly vertical
+  std::vector<Cluster> tilted = f.clusters;
+  tilted[1].centroid.x() += 0.1;  // the second piece leans 18 deg off the first
+  EXPECT_EQ(findTrunkPath(tilted, adjacency, config).trunk.size(), 1u);
+}
+
+TEST(Disturbances, PartitionAtARiseAfterAFlatRun) {
+  std::vector<Slice> slices(12);
+  const double shares[12] = {0, 0, 0, 0.4, 0.4, 0.1, 0.1, 0.1, 0.1, 0.5, 0.2, 0.2};
+  for (int i = 0; i < 12; ++i) {
+    slices[i].s0 = 0.05 * i;
+    slices[i].outlier_share = shares[i];
+  }
+  const auto cuts = disturbancePartitions(slices, 0.05, 2, 0.6);
+  ASSERT_EQ(cuts.size(), 4u);
+  EXPECT_DOUBLE_EQ(cuts[0], 0.0);
+  EXPECT_NEAR(cuts[1], 0.15, 1e-12);  // slice 3 rises after three flat slices
+  EXPECT_NEAR(cuts[2], 0.45, 1e-12);  // slice 9 rises after a flat run of three
+  EXPECT_DOUBLE_EQ(cuts[3], 0.6);
+}
+
+TEST(TrunkModel, TaperedTrunkWithBranchesGivesSegmentsAndRadii) {
+  Points pts;
+  // Two trunk parts of different radius and two branches at 0.5 m and 1.0 m.
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.04, 0.6);
+  addCylinder(pts, {0, 0, 0.6}, {0, 0, 1}, 0.03, 0.6);
+  addCylinder(pts, {0.04, 0, 0.5}, {1, 0, 0}, 0.012, 0.3);
+  addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.01, 0.3);
+  std::vector<int> region(pts.size());
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.0;
+  config.beam_spread = 0.0;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.035, config);
+  ASSERT_GE(trunk.cylinders.size(), 2u);
+  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+    const auto& c = trunk.cylinders[i];
+    const double expected = c.center.z() < 0.6 ? 0.04 : 0.03;
+    if (std::abs(c.center.z() - 0.6) > 0.2)
+      EXPECT_NEAR(c.radius, expected, 0.002) << "segment " << i;
+    EXPECT_GT(c.axis.z(), 0.99);
+  }
+  // The outlier curve rises at both branch heights.
+  double share_at_branch = 0.0, share_clear = 1.0;
+  for (const auto& s : trunk.slices) {
+    if (std::abs(s.s0 - 0.5) < 0.03)
+      share_at_branch = std::max(share_at_branch, s.outlier_share);
+    if (std::abs(s.s0 - 0.3) < 0.03)
+      share_clear = std::min(share_clear, s.outlier_share);
+  }
+  EXPECT_GT(share_at_branch, share_clear + 0.05);
+}
+
+TEST(TrunkModel, TooLittleIsNoTrunk) {
+  ModelerConfig config;
+  try {
+    modelTrunk(Points(5, Eigen::Vector3d::Zero()), {0, 1, 2}, {{0, 0, 0}, {0, 0, 1}}, 0.03, config);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NO_TRUNK);
+  }
+}
+
+TEST(ModelerConfig, PaperDefaultsAndValidation) {
+  const ModelerConfig c;
+  EXPECT_EQ(c.cluster_points, 3000);
+  EXPECT_DOUBLE_EQ(c.split_error, 0.004);
+  EXPECT_DOUBLE_EQ(c.merge_distance, 0.05);
+  EXPECT_DOUBLE_EQ(c.n_low, 0.3);
+  EXPECT_DOUBLE_EQ(c.n_high, 0.7);
+  EXPECT_DOUBLE_EQ(c.psi_t, 72.0);
+  EXPECT_NO_THROW(c.validate());
+  const ModelerConfig p = ModelerConfig::paper();
+  EXPECT_FALSE(p.ours_constrain_ransac || p.ours_follow_diameter || p.ours_correct_noise_bias ||
+               p.ours_branch_shell || p.ours_derive_parameters || p.ours_remove_clutter);
+  ModelerConfig bad;
+  bad.n_high = 0.2;  // below n_low
+  EXPECT_THROW(bad.validate(), Error);
+}
+
+TEST(ModelerConfig, LoadsYamlAndRejectsBadFiles) {
+  test::TempDir dir;
+  const auto ok = dir.write("ok.yaml", "tree_modeler:\n  psi_t: 60\n  ours_branch_shell: false\n");
+  const ModelerConfig c = loadModelerConfig(ok);
+  EXPECT_DOUBLE_EQ(c.psi_t, 60.0);
+  EXPECT_FALSE(c.ours_branch_shell);
+  EXPECT_DOUBLE_EQ(c.split_error, 0.004);  // untouched default
+  auto code = [](const std::string& path) {
+    try {
+      loadModelerConfig(path);
+    } catch (const Error& e) {
+      return e.code();
+    }
+    return ErrorCode::IO_FAILURE;  // not thrown: fails the comparisons below
+  };
+  EXPECT_EQ(code(dir.write("unknown.yaml", "psi_tt: 60\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.write("type.yaml", "psi_t: steep\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.write("range.yaml", "psi_t: 120\n")), ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(dir.write("broken.yaml", "psi_t: [1,\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.file("missing.yaml")), ErrorCode::FILE_NOT_FOUND);
+}
+
+TEST(ModelerConfig, ShippedConfigLoads) {
+  const ModelerConfig c =
+      loadModelerConfig(std::string(DTM_TEST_DATA_DIR) + "/../../config/tree_modeler.yaml");
+  EXPECT_DOUBLE_EQ(c.psi_t, 72.0);
+  EXPECT_TRUE(c.ours_follow_diameter);
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

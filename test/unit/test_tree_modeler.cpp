@@ -1,0 +1,179 @@
+#include <gtest/gtest.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/simulation/dataset.h"
+#include "temp_dir.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+ErrorCode errorOf(const TreeModeler& modeler, const Points& pts) {
+  try {
+    modeler.model(pts);
+  } catch (const Error& e) {
+    return e.code();
+  }
+  return ErrorCode::IO_FAILURE;  // not thrown: fails the comparisons below
+}
+
+TEST(TreeModeler, BadInputsGiveDocumentedErrors) {
+  const TreeModeler modeler(ModelerConfig{});
+  EXPECT_EQ(errorOf(modeler, {}), ErrorCode::EMPTY_INPUT);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(errorOf(modeler, Points(500, Eigen::Vector3d(nan, 0, 0))), ErrorCode::EMPTY_INPUT);
+  EXPECT_EQ(errorOf(modeler, Points(50, Eigen::Vector3d::Ones())), ErrorCode::EMPTY_INPUT);
+  // A flat patch of ground has no trunk.
+  Points ground;
+  for (int i = 0; i < 60; ++i) {
+    for (int k = 0; k < 60; ++k)
+      ground.emplace_back(0.01 * i, 0.01 * k, 0.0);
+  }
+  ModelerConfig keep_ground;
+  keep_ground.ours_remove_clutter = false;
+  EXPECT_EQ(errorOf(TreeModeler(keep_ground), ground), ErrorCode::NO_TRUNK);
+  ModelerConfig bad;
+  bad.psi_t = 0.0;
+  EXPECT_THROW(TreeModeler{bad}, Error);
+}
+
+/// A synthetic tree scanned by a reduced plan (8 of the 40 views, full resolution): seconds.
+struct Scan {
+  CloudPtr cloud;
+  evaluation::GroundTruth truth;
+};
+
+Scan scanTree(const std::string& preset, std::uint64_t seed, double noise) {
+  test::TempDir dir;
+  simulation::DatasetOptions o;
+  o.orchard.preset = preset;
+  o.seed = seed;
+  o.sensor.range_noise_sigma = noise;
+  o.plan.heights = {1.5, 3.0};
+  o.plan.positions_per_height = 1;
+  o.plan.slide_steps = 2;
+  o.plan.slide_step = 0.2;
+  o.write_views = false;
+  simulation::writeDataset(o, dir.file("d"));
+  Scan s;
+  s.cloud = io::readCloud(dir.file("d/target.pcd")).cloud;
+  s.truth = io::readTruthFile(dir.file("d/truth.json"));
+  return s;
+}
+
+TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
+  const Scan scan = scanTree("young_tall_spindle", 3, 0.006);
+  const TreeModeler modeler(ModelerConfig{});
+  const ModelResult result = modeler.model(*scan.cloud);
+  const auto score = evaluation::evaluate(result.model, scan.truth);
+  RecordProperty("f1", std::to_string(score.f1));
+  RecordProperty("branch_mae_mm", std::to_string(1000 * score.branch_mae));
+  RecordProperty("trunk_mae_mm", std::to_string(1000 * score.trunk_mae));
+  // Bounds a little under what this configuration measures (docs: README, modeler section):
+  // they catch regressions, they are not the product targets, which make bench reports.
+  EXPECT_GE(score.f1, 0.75) << evaluation::formatTable({score});
+  EXPECT_LE(score.branch_mae, 0.009) << evaluation::formatTable({score});
+  EXPECT_LE(score.trunk_mae, 0.012) << evaluation::formatTable({score});
+  EXPECT_GE(score.coverage, 0.85) << evaluation::formatTable({score});
+  EXPECT_EQ(result.classes.size(), result.points.size());
+  // Measurements are consistent with the cylinders.
+  for (const auto& b : result.model.primary_branches) {
+    EXPECT_NEAR(b.measurement.diameter_ratio, b.cylinder.diameter / b.measurement.trunk_diameter,
+                1e-9);
+    EXPECT_EQ(b.measurement.prune, b.measurement.diameter_ratio > 0.5);
+    EXPECT_GE(b.trunk_segment, 0);
+    EXPECT_LT(b.trunk_segment, static_cast<int>(result.model.trunk.size()));
+  }
+}
+
+TEST(TreeModeler, SameInputSameModel) {
+  const Scan scan = scanTree("young_tall_spindle", 4, 0.003);
+  const TreeModeler modeler(ModelerConfig{});
+  const std::string a = io::modelToJson(modeler.model(*scan.cloud).model);
+  const std::string b = io::modelToJson(modeler.model(*scan.cloud).model);
+  // Runtime differs between runs; everything before it is the model.
+  EXPECT_EQ(a.substr(0, a.find("runtime_s")), b.substr(0, b.find("runtime_s")));
+}
+
+TEST(TreeModeler, SurveyCoordinatesGiveTheSameModelShifted) {
+  const Scan scan = scanTree("young_tall_spindle", 5, 0.003);
+  test::TempDir dir;
+  const Eigen::Vector3d offset(512345.0, 5412345.0, 210.0);
+  io::writeCloud(dir.file("utm.xyz"), *scan.cloud, offset);
+  const auto loaded = io::readCloud(dir.file("utm.xyz"));
+  EXPECT_FALSE(loaded.offset.isZero());
+  const TreeModeler modeler(ModelerConfig{});
+  const auto local = modeler.model(*scan.cloud).model;
+  const auto shifted =
+      io::modelFromJson(io::modelToJson(modeler.model(*loaded.cloud).model, loaded.offset));
+  // Recentring moves points by float rounding, which can move a partition; the trunk's base
+  // and extent must not move.
+  ASSERT_FALSE(local.trunk.empty());
+  ASSERT_FALSE(shifted.trunk.empty());
+  auto bottom = [](const modeling::TreeModel& m) {
+    const auto& c = m.trunk.front();
+    return Eigen::Vector3d(c.center - 0.5 * c.length * c.axis);
+  };
+  auto top = [](const modeling::TreeModel& m) {
+    const auto& c = m.trunk.back();
+    return Eigen::Vector3d(c.center + 0.5 * c.length * c.axis);
+  };
+  EXPECT_LT((bottom(shifted) - bottom(local) - offset).norm(), 0.03);
+  EXPECT_LT((top(shifted) - top(local) - offset).norm(), 0.1);
+  EXPECT_NEAR(shifted.trunk[0].diameter, local.trunk[0].diameter, 0.003);
+  EXPECT_NEAR(static_cast<double>(shifted.primary_branches.size()),
+              static_cast<double>(local.primary_branches.size()), 3.0);
+}
+
+std::string realCloud(const char* name) {
+  const std::string path = std::string(DTM_SHARED_DATA_DIR) + "/real/" + name;
+  if (!std::filesystem::exists(path)) {
+    if (std::getenv("CI"))
+      ADD_FAILURE() << "missing shared data " << path;
+    return {};
+  }
+  return path;
+}
+
+TEST(TreeModeler, RealTree1FindsATrunkQuickly) {
+  const std::string path = realCloud("adtree_tree1.xyz");
+  if (path.empty())
+    GTEST_SKIP() << "../shared/data not present";
+  const auto cloud = io::readCloud(path);
+  const auto result = TreeModeler(ModelerConfig{}).model(*cloud.cloud);
+  ASSERT_FALSE(result.model.trunk.empty());
+  double length = 0.0;
+  for (const auto& c : result.model.trunk)
+    length += c.length;
+  EXPECT_GT(length, 1.0);
+  EXPECT_LT(result.model.runtime_s, 10.0);
+}
+
+TEST(TreeModeler, RealTree13FinishesWithAModelOrTheNoTrunkError) {
+  // Sparse and noisy (6,991 points over 10 m): today the modeler reports no_trunk here (see the
+  // issue notes); what must hold is a clean, documented outcome.
+  const std::string path = realCloud("adtree_tree13.xyz");
+  if (path.empty())
+    GTEST_SKIP() << "../shared/data not present";
+  const auto cloud = io::readCloud(path);
+  try {
+    const auto result = TreeModeler(ModelerConfig{}).model(*cloud.cloud);
+    EXPECT_FALSE(result.model.trunk.empty());
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NO_TRUNK) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
