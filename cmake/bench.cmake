@@ -1,6 +1,9 @@
 # Benchmarks (make bench): bench/*.cpp -> bench_<name>, Google Benchmark, never run by tests.
 find_package(benchmark QUIET)
 file(GLOB DTM_BENCH_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/bench/*.cpp)
+# bench/accuracy_*.cpp are plain programs printing accuracy tables, not Google Benchmarks.
+file(GLOB DTM_ACCURACY_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/bench/accuracy_*.cpp)
+list(REMOVE_ITEM DTM_BENCH_SOURCES ${DTM_ACCURACY_SOURCES})
 if(benchmark_FOUND AND DTM_BENCH_SOURCES)
   add_custom_target(benchmarks)
   foreach(bench_source ${DTM_BENCH_SOURCES})
@@ -10,5 +13,11 @@ if(benchmark_FOUND AND DTM_BENCH_SOURCES)
     target_compile_definitions(bench_${bench} PRIVATE
       DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}")
     add_dependencies(benchmarks bench_${bench})
+  endforeach()
+  foreach(source ${DTM_ACCURACY_SOURCES})
+    get_filename_component(name ${source} NAME_WE)
+    add_executable(${name} EXCLUDE_FROM_ALL ${source})
+    target_link_libraries(${name} dtm_core)
+    add_dependencies(benchmarks ${name})
   endforeach()
 endif()

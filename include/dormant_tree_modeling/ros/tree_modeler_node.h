@@ -1,0 +1,57 @@
+#pragma once
+
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Trigger.h>
+
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+/// @brief ROS wrapper of the tree modeler.
+///
+/// Subscribes `tree_cloud` (sensor_msgs/PointCloud2); publishes, latched, `tree_model`
+/// (dormant_tree_modeling/TreeModel), `markers` (visualization_msgs/MarkerArray: trunk brown,
+/// primaries green, pruning candidates red, each labelled with its diameter in cm) and
+/// `segments` (PointCloud2 of the modeled points with an `intensity` field: 0 other,
+/// 1 trunk, 2 primary branch). Service `~model_tree` (std_srvs/Trigger) models the last cloud
+/// again. Parameters: `~config_file` (YAML of ModelerConfig; empty: defaults).
+/// Modeling runs on a worker thread; a cloud arriving while one is being modeled waits in a
+/// single slot, replacing (with a warning) any cloud already waiting there.
+class TreeModelerNode {
+ public:
+  /// @throws Error when the configuration cannot be loaded
+  TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~TreeModelerNode();
+  TreeModelerNode(const TreeModelerNode&) = delete;
+  TreeModelerNode& operator=(const TreeModelerNode&) = delete;
+
+ private:
+  void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
+  bool modelTree(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void enqueue(const sensor_msgs::PointCloud2ConstPtr& msg);
+  void workerLoop();
+  /// Models one cloud and publishes; returns a one-line summary or throws Error.
+  std::string process(const sensor_msgs::PointCloud2& msg);
+
+  modeling::TreeModeler modeler_;
+  ros::Subscriber cloud_sub_;
+  ros::Publisher model_pub_, marker_pub_, segments_pub_;
+  ros::ServiceServer model_srv_;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  sensor_msgs::PointCloud2ConstPtr pending_;  // waiting to be modeled
+  sensor_msgs::PointCloud2ConstPtr last_;     // last cloud received, for ~model_tree
+  bool busy_ = false;
+  bool stop_ = false;
+  std::thread worker_;
+};
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

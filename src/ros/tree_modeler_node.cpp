@@ -1,0 +1,157 @@
+#include "dormant_tree_modeling/ros/tree_modeler_node.h"
+
+#include <dormant_tree_modeling/TreeModel.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/model_messages.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+namespace {
+
+modeling::ModelerConfig loadConfig(ros::NodeHandle& pnh) {
+  const std::string file = pnh.param<std::string>("config_file", "");
+  if (file.empty()) {
+    ROS_WARN(
+        "~config_file not set: using the built-in defaults (config/tree_modeler.yaml holds them "
+        "too)");
+    return modeling::ModelerConfig{};
+  }
+  return modeling::loadModelerConfig(file);
+}
+
+sensor_msgs::PointCloud2 segmentsMsg(const modeling::ModelResult& result,
+                                     const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  sensor_msgs::PointCloud2Modifier modifier(msg);
+  modifier.setPointCloud2Fields(
+      4, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32, "z", 1,
+      sensor_msgs::PointField::FLOAT32, "intensity", 1, sensor_msgs::PointField::FLOAT32);
+  modifier.resize(result.points.size());
+  sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), y(msg, "y"), z(msg, "z"),
+      label(msg, "intensity");
+  for (std::size_t i = 0; i < result.points.size(); ++i, ++x, ++y, ++z, ++label) {
+    *x = static_cast<float>(result.points[i].x());
+    *y = static_cast<float>(result.points[i].y());
+    *z = static_cast<float>(result.points[i].z());
+    *label = static_cast<float>(result.classes[i]);
+  }
+  msg.is_dense = true;
+  return msg;
+}
+
+}  // namespace
+
+TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+    : modeler_(loadConfig(pnh)) {
+  model_pub_ = nh.advertise<dormant_tree_modeling::TreeModel>("tree_model", 1, true);
+  marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
+  segments_pub_ = nh.advertise<sensor_msgs::PointCloud2>("segments", 1, true);
+  worker_ = std::thread(&TreeModelerNode::workerLoop, this);
+  cloud_sub_ = nh.subscribe("tree_cloud", 1, &TreeModelerNode::cloudCallback, this);
+  model_srv_ = pnh.advertiseService("model_tree", &TreeModelerNode::modelTree, this);
+  ROS_INFO("tree_modeler: waiting for clouds on %s", cloud_sub_.getTopic().c_str());
+}
+
+TreeModelerNode::~TreeModelerNode() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable())
+    worker_.join();
+}
+
+void TreeModelerNode::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  enqueue(msg);
+}
+
+void TreeModelerNode::enqueue(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_ = msg;
+    if (pending_) {
+      ROS_WARN(
+          "tree_modeler: still modeling; the waiting cloud (stamp %.3f) is replaced by a newer one",
+          pending_->header.stamp.toSec());
+    }
+    pending_ = msg;
+  }
+  wake_.notify_one();
+}
+
+bool TreeModelerNode::modelTree(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  sensor_msgs::PointCloud2ConstPtr cloud;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    cloud = last_;
+  }
+  if (!cloud) {
+    res.success = false;
+    res.message = "no cloud received yet on " + cloud_sub_.getTopic();
+    return true;
+  }
+  // Runs here, on the service's thread; the subscriber keeps queueing to the worker.
+  try {
+    res.message = process(*cloud);
+    res.success = true;
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+void TreeModelerNode::workerLoop() {
+  for (;;) {
+    sensor_msgs::PointCloud2ConstPtr cloud;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || pending_; });
+      if (stop_)
+        return;
+      cloud = pending_;
+      pending_.reset();
+      busy_ = true;
+    }
+    try {
+      ROS_INFO("tree_modeler: %s", process(*cloud).c_str());
+    } catch (const Error& e) {
+      ROS_ERROR("tree_modeler: %s: %s", errorCodeName(e.code()), e.what());
+    } catch (const std::exception& e) {
+      ROS_ERROR("tree_modeler: %s", e.what());
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    busy_ = false;
+  }
+}
+
+std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
+  std::size_t dropped = 0;
+  const CloudPtr cloud = fromMsg(msg, &dropped);
+  if (dropped > 0)
+    ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
+  const modeling::ModelResult result = modeler_.model(*cloud);
+  model_pub_.publish(toMsg(result.model, msg.header));
+  marker_pub_.publish(toMarkers(result.model, msg.header));
+  segments_pub_.publish(segmentsMsg(result, msg.header));
+  std::size_t prune = 0;
+  for (const auto& b : result.model.primary_branches)
+    prune += b.measurement.prune;
+  std::ostringstream s;
+  s << result.model.trunk.size() << " trunk cylinders, " << result.model.primary_branches.size()
+    << " primary branches (" << prune << " to prune) from " << result.model.input_points
+    << " points in " << result.model.runtime_s << " s";
+  return s.str();
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,86 @@
+#include <dormant_tree_modeling/TreeModel.h>
+#include <gtest/gtest.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Trigger.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <filesystem>
+
+#include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/simulation/dataset.h"
+
+namespace {
+
+using namespace dormant_tree_modeling;
+
+/// A synthetic tree from 8 views of the plan, as the registration would publish it.
+sensor_msgs::PointCloud2 syntheticTree() {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("dtm_rostest_" + std::to_string(getpid()));
+  simulation::DatasetOptions o;
+  o.seed = 3;
+  o.sensor.range_noise_sigma = 0.006;
+  o.plan.heights = {1.5, 3.0};
+  o.plan.positions_per_height = 1;
+  o.plan.slide_steps = 2;
+  o.plan.slide_step = 0.2;
+  o.write_views = false;
+  simulation::writeDataset(o, dir.string());
+  const auto cloud = io::readCloud((dir / "target.pcd").string());
+  std::filesystem::remove_all(dir);
+  return ros_layer::toMsg(*cloud.cloud, "tree", ros::Time::now());
+}
+
+TEST(TreeModelerNode, PublishesModelMarkersAndSegments) {
+  ros::NodeHandle nh;
+  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("tree_cloud", 1, true);
+  pub.publish(syntheticTree());
+  const auto model = ros::topic::waitForMessage<dormant_tree_modeling::TreeModel>(
+      "tree_model", nh, ros::Duration(90.0));
+  ASSERT_TRUE(model) << "no TreeModel within 90 s";
+  EXPECT_EQ(model->header.frame_id, "tree");
+  ASSERT_FALSE(model->trunk.empty());
+  EXPECT_GT(model->primary_branches.size(), 5u);
+  EXPECT_EQ(model->measurements.size(), model->primary_branches.size());
+  for (const auto& c : model->trunk) {
+    EXPECT_EQ(c.role, dormant_tree_modeling::Cylinder::TRUNK);
+    EXPECT_GT(c.radius, 0.005);
+    EXPECT_LT(c.radius, 0.06);
+  }
+  for (const auto& b : model->primary_branches)
+    EXPECT_GE(b.parent_id, 0);
+  const auto markers = ros::topic::waitForMessage<visualization_msgs::MarkerArray>(
+      "markers", nh, ros::Duration(5.0));
+  ASSERT_TRUE(markers);
+  // DELETEALL, then a cylinder and a label for every trunk segment and branch.
+  EXPECT_EQ(markers->markers.size(),
+            1 + 2 * (model->trunk.size() + model->primary_branches.size()));
+  const auto segments =
+      ros::topic::waitForMessage<sensor_msgs::PointCloud2>("segments", nh, ros::Duration(5.0));
+  ASSERT_TRUE(segments);
+  EXPECT_GT(segments->width * segments->height, 1000u);
+}
+
+TEST(TreeModelerNode, ServiceRemodelsTheLastCloud) {
+  ros::NodeHandle nh;
+  ASSERT_TRUE(ros::service::waitForService("tree_modeler/model_tree", ros::Duration(10.0)));
+  std_srvs::Trigger srv;
+  ASSERT_TRUE(ros::service::call("tree_modeler/model_tree", srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_NE(srv.response.message.find("trunk cylinders"), std::string::npos)
+      << srv.response.message;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tree_modeler_node");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
