@@ -8,10 +8,16 @@ foreach(test_source ${DTM_UNIT_TESTS})
   catkin_add_gtest(${test_name} ${test_source})
   target_link_libraries(${test_name} dtm_core ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(${test_name} PRIVATE
-    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}")
+    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"
+    DTM_TOOL_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
 endforeach()
+# The tool tests run the built tools.
+if(TARGET test_tools)
+  add_dependencies(test_tools tree_model evaluate_model)
+endif()
 
-file(GLOB DTM_ROSTEST_NODES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.cpp)
+file(GLOB DTM_ROSTEST_NODES
+ CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.cpp)
 foreach(test_source ${DTM_ROSTEST_NODES})
   get_filename_component(test_name ${test_source} NAME_WE)
   add_executable(${test_name} EXCLUDE_FROM_ALL ${test_source})
