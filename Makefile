@@ -9,7 +9,7 @@ PYTHON := /usr/bin/python3
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=$(PYTHON) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCATKIN_ENABLE_TESTING=ON
 SOURCES = $(shell cd $(ROOT) && git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -v '^\.ws/')
 
-.PHONY: all setup build test bench format format-check lint clean help
+.PHONY: all setup build test bench demo format format-check lint clean help
 
 all: build
 
@@ -18,6 +18,7 @@ help:
 	@echo "make build         build everything (BUILD_TYPE=$(BUILD_TYPE))"
 	@echo "make test          setup + build + every gtest and rostest; ends 'N passed, N failed'"
 	@echo "make bench         setup + build + benchmarks (timings, memory, accuracy tables)"
+	@echo "make demo          setup + build + a synthetic tree scanned, modeled and scored -> results/"
 	@echo "make format        clang-format the sources in place"
 	@echo "make format-check  fail on any badly formatted source; check the core has no ROS"
 	@echo "make clean         remove the build (keeps installed packages)"
@@ -40,6 +41,9 @@ test: build
 bench: build
 	$(MAKE) -C $(WS)/build -j$(JOBS) benchmarks
 	bash scripts/run_benchmarks.sh $(WS)/devel/lib/dormant_tree_modeling
+
+demo: build
+	bash scripts/demo.sh
 
 format: setup
 	clang-format -i $(SOURCES)

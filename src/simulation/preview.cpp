@@ -44,6 +44,50 @@ struct Canvas {
 
 }  // namespace
 
+namespace {
+
+/// A front-view canvas (x right, z up) framed on a box, with the cloud drawn in grey.
+struct FrontView {
+  Eigen::Vector2d lo, hi;
+  double scale = 1.0;
+  int height = 1;
+  Canvas canvas{1, 1};
+
+  FrontView(const Cloud& cloud, Eigen::Vector2d box_lo, Eigen::Vector2d box_hi, int width) {
+    lo = box_lo - Eigen::Vector2d(0.3, 0.1);
+    hi = box_hi + Eigen::Vector2d(0.3, 0.2);
+    lo.y() = std::min(lo.y(), 0.0);
+    scale = width / (hi.x() - lo.x());
+    height = std::max(1, static_cast<int>((hi.y() - lo.y()) * scale));
+    canvas = Canvas(width, height);
+    // Points: darker when nearer the viewer (smaller y), so depth reads at a glance.
+    for (const auto& p : cloud.points) {
+      const double shade = std::clamp(60.0 + 40.0 * (p.y + 1.5), 40.0, 200.0);
+      const std::uint8_t c[3] = {static_cast<std::uint8_t>(shade), static_cast<std::uint8_t>(shade),
+                                 static_cast<std::uint8_t>(shade)};
+      canvas.put(static_cast<int>(px(p.x)), static_cast<int>(py(p.z)), c);
+    }
+  }
+  double px(double x) const { return (x - lo.x()) * scale; }
+  double py(double z) const { return height - 1 - (z - lo.y()) * scale; }
+  void segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double diameter,
+               const std::uint8_t c[3]) {
+    canvas.line(px(a.x()), py(a.z()), px(b.x()), py(b.z()), std::max(1.0, 0.5 * diameter * scale),
+                c);
+  }
+  void save(const std::string& path) const {
+    if (!stbi_write_png(path.c_str(), canvas.w, canvas.h, 3, canvas.rgb.data(), canvas.w * 3)) {
+      throw Error(ErrorCode::IO_FAILURE, "cannot write " + path);
+    }
+  }
+};
+
+const std::uint8_t BROWN[3] = {140, 80, 20};
+const std::uint8_t GREEN[3] = {20, 170, 40};
+const std::uint8_t RED[3] = {220, 30, 30};
+
+}  // namespace
+
 void renderPreview(const Cloud& cloud, const evaluation::GroundTruth& truth,
                    const std::string& path, int width) {
   Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
@@ -56,36 +100,46 @@ void renderPreview(const Cloud& cloud, const evaluation::GroundTruth& truth,
   grow(truth.trunk);
   for (const auto& b : truth.primary_branches)
     grow(b);
-  lo -= Eigen::Vector2d(0.3, 0.1);
-  hi += Eigen::Vector2d(0.3, 0.2);
-  lo.y() = std::min(lo.y(), 0.0);
-  const double scale = width / (hi.x() - lo.x());
-  const int height = std::max(1, static_cast<int>((hi.y() - lo.y()) * scale));
-  Canvas canvas(width, height);
-  auto px = [&](double x) { return (x - lo.x()) * scale; };
-  auto py = [&](double z) { return height - 1 - (z - lo.y()) * scale; };
-  // Points: darker when nearer the viewer (smaller y), so depth reads at a glance.
-  for (const auto& p : cloud.points) {
-    const double shade = std::clamp(60.0 + 40.0 * (p.y + 1.5), 40.0, 200.0);
-    const std::uint8_t c[3] = {static_cast<std::uint8_t>(shade), static_cast<std::uint8_t>(shade),
-                               static_cast<std::uint8_t>(shade)};
-    canvas.put(static_cast<int>(px(p.x)), static_cast<int>(py(p.z)), c);
-  }
-  const std::uint8_t brown[3] = {140, 80, 20};
-  const std::uint8_t green[3] = {20, 170, 40};
+  FrontView view(cloud, lo, hi, width);
   auto draw = [&](const evaluation::Polyline& p, const std::uint8_t c[3]) {
-    for (std::size_t i = 0; i + 1 < p.points.size(); ++i) {
-      const double r = std::max(1.0, 0.5 * p.diameters[i] * scale);
-      canvas.line(px(p.points[i].x()), py(p.points[i].z()), px(p.points[i + 1].x()),
-                  py(p.points[i + 1].z()), r, c);
-    }
+    for (std::size_t i = 0; i + 1 < p.points.size(); ++i)
+      view.segment(p.points[i], p.points[i + 1], p.diameters[i], c);
   };
   for (const auto& b : truth.primary_branches)
-    draw(b, green);
-  draw(truth.trunk, brown);
-  if (!stbi_write_png(path.c_str(), canvas.w, canvas.h, 3, canvas.rgb.data(), canvas.w * 3)) {
-    throw Error(ErrorCode::IO_FAILURE, "cannot write " + path);
+    draw(b, GREEN);
+  draw(truth.trunk, BROWN);
+  view.save(path);
+}
+
+void renderModelPreview(const Cloud& cloud, const modeling::TreeModel& model,
+                        const std::string& path, int width) {
+  Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+  auto ends = [](const modeling::CylinderModel& c) {
+    return std::make_pair(Eigen::Vector3d(c.center - 0.5 * c.length * c.axis),
+                          Eigen::Vector3d(c.center + 0.5 * c.length * c.axis));
+  };
+  auto grow = [&](const modeling::CylinderModel& c) {
+    for (const auto& e : {ends(c).first, ends(c).second}) {
+      lo = lo.cwiseMin(Eigen::Vector2d(e.x(), e.z()));
+      hi = hi.cwiseMax(Eigen::Vector2d(e.x(), e.z()));
+    }
+  };
+  for (const auto& c : model.trunk)
+    grow(c);
+  for (const auto& b : model.primary_branches)
+    grow(b.cylinder);
+  if (lo.x() > hi.x())
+    throw Error(ErrorCode::INVALID_ARGUMENT, "empty model: nothing to render");
+  FrontView view(cloud, lo, hi, width);
+  for (const auto& b : model.primary_branches) {
+    const auto e = ends(b.cylinder);
+    view.segment(e.first, e.second, b.cylinder.diameter, b.measurement.prune ? RED : GREEN);
   }
+  for (const auto& c : model.trunk) {
+    const auto e = ends(c);
+    view.segment(e.first, e.second, c.diameter, BROWN);
+  }
+  view.save(path);
 }
 
 void writeRangePgm(const std::string& path, int rows, int cols, const float* ranges_m) {

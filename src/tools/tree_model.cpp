@@ -7,6 +7,7 @@
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/simulation/preview.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
@@ -35,14 +36,16 @@ int exitCode(ErrorCode code) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string input, output, params, csv;
+  std::string input, output, params, csv, picture;
   po::options_description desc(
-      "Usage: tree_model INPUT --output model.json [--params FILE] [--csv FILE] [--paper]\n"
+      "Usage: tree_model INPUT --output model.json [--params FILE] [--csv FILE] [--picture PNG] "
+      "[--paper]\n"
       "Models the trunk and primary branches of the tree in INPUT (.pcd, .ply, or x y z text)");
   desc.add_options()("help,h", "this help")("input", po::value(&input), "input cloud")(
       "output,o", po::value(&output), "model JSON to write (docs/evaluation.md)")(
       "params,p", po::value(&params), "modeler parameters, YAML (config/tree_modeler.yaml)")(
       "csv", po::value(&csv), "also write the cylinders as CSV")(
+      "picture", po::value(&picture), "also render the cylinders over the cloud (front view, PNG)")(
       "paper", "the paper's method only (every improvement switched off), for comparisons")(
       "verbose,v", "print stage timings and diagnostics to stderr");
   po::positional_options_description positional;
@@ -72,6 +75,8 @@ int main(int argc, char** argv) {
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));
     if (!csv.empty())
       io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));
+    if (!picture.empty())
+      simulation::renderModelPreview(*cloud.cloud, result.model, picture);
     if (vm.count("verbose")) {
       std::cerr << "tree_model: " << result.points.size() << " points modeled, noise sigma "
                 << 1000.0 * result.noise_sigma << " mm, e_t " << 1000.0 * result.split_error

@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,8 +18,10 @@ namespace {
 
 /// Runs a built tool with arguments, returns its exit status; stdout+stderr into `output`.
 int run(const std::string& tool, const std::string& args, std::string* output = nullptr) {
-  const std::string log = (std::filesystem::temp_directory_path() / ("dtm_tool_" + std::to_string(getpid()))).string();
-  const std::string cmd = std::string(DTM_TOOL_DIR) + "/" + tool + " " + args + " > " + log + " 2>&1";
+  const std::string log =
+      (std::filesystem::temp_directory_path() / ("dtm_tool_" + std::to_string(getpid()))).string();
+  const std::string cmd =
+      std::string(DTM_TOOL_DIR) + "/" + tool + " " + args + " > " + log + " 2>&1";
   const int status = std::system(cmd.c_str());
   if (output) {
     std::ifstream f(log);
@@ -35,18 +37,30 @@ TEST(TreeModelTool, ExitCodesAreDistinctAndDocumented) {
   test::TempDir dir;
   std::string out;
   EXPECT_EQ(run("tree_model", "", &out), 2) << out;  // usage
-  EXPECT_EQ(run("tree_model", dir.file("absent.pcd") + " -o " + dir.file("m.json"), &out), 3) << out;
+  EXPECT_EQ(run("tree_model", dir.file("absent.pcd") + " -o " + dir.file("m.json"), &out), 3)
+      << out;
   EXPECT_NE(out.find("file_not_found"), std::string::npos) << out;
-  EXPECT_EQ(run("tree_model", dir.write("bad.xyz", "1 2 three\n") + " -o " + dir.file("m.json"), &out), 3) << out;
-  EXPECT_EQ(run("tree_model", dir.write("empty.xyz", "# nothing\n") + " -o " + dir.file("m.json"), &out), 4) << out;
+  EXPECT_EQ(
+      run("tree_model", dir.write("bad.xyz", "1 2 three\n") + " -o " + dir.file("m.json"), &out), 3)
+      << out;
+  EXPECT_EQ(
+      run("tree_model", dir.write("empty.xyz", "# nothing\n") + " -o " + dir.file("m.json"), &out),
+      4)
+      << out;
   std::string plane;
   for (int i = 0; i < 60; ++i) {
-    for (int k = 0; k < 60; ++k) plane += std::to_string(0.01 * i) + " " + std::to_string(0.01 * k) + " 1.0\n";
+    for (int k = 0; k < 60; ++k)
+      plane += std::to_string(0.01 * i) + " " + std::to_string(0.01 * k) + " 1.0\n";
   }
-  EXPECT_EQ(run("tree_model", dir.write("plane.xyz", plane) + " -o " + dir.file("m.json"), &out), 5) << out;
+  EXPECT_EQ(run("tree_model", dir.write("plane.xyz", plane) + " -o " + dir.file("m.json"), &out), 5)
+      << out;
   EXPECT_NE(out.find("no_trunk"), std::string::npos) << out;
-  EXPECT_EQ(run("tree_model", dir.file("plane.xyz") + " -o " + dir.file("m.json") + " -p " +
-                                  dir.write("p.yaml", "psi_t: 500\n"), &out), 6) << out;
+  EXPECT_EQ(run("tree_model",
+                dir.file("plane.xyz") + " -o " + dir.file("m.json") + " -p " +
+                    dir.write("p.yaml", "psi_t: 500\n"),
+                &out),
+            6)
+      << out;
   // Exactly one line on stderr for a failure.
   EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
   EXPECT_FALSE(std::filesystem::exists(dir.file("m.json")));
@@ -54,10 +68,14 @@ TEST(TreeModelTool, ExitCodesAreDistinctAndDocumented) {
 
 TEST(TreeModelTool, ModelsARealCloudAndEvaluateModelScoresIt) {
   const std::string tree = std::string(DTM_SHARED_DATA_DIR) + "/real/adtree_tree1.xyz";
-  if (!std::filesystem::exists(tree)) GTEST_SKIP() << "../shared/data not present";
+  if (!std::filesystem::exists(tree))
+    GTEST_SKIP() << "../shared/data not present";
   test::TempDir dir;
   std::string out;
-  ASSERT_EQ(run("tree_model", tree + " --output " + dir.file("m.json") + " --csv " + dir.file("c.csv"), &out), 0) << out;
+  ASSERT_EQ(run("tree_model",
+                tree + " --output " + dir.file("m.json") + " --csv " + dir.file("c.csv"), &out),
+            0)
+      << out;
   const auto model = io::readModelFile(dir.file("m.json"));
   ASSERT_FALSE(model.trunk.empty());
   // Survey-style input coordinates come back as given (tree1 sits at y ~ 18 m).
@@ -72,10 +90,14 @@ TEST(TreeModelTool, ModelsARealCloudAndEvaluateModelScoresIt) {
     truth.trunk.points.push_back(c.center - 0.5 * c.length * c.axis);
     truth.trunk.diameters.push_back(c.diameter);
   }
-  truth.trunk.points.push_back(model.trunk.back().center + 0.5 * model.trunk.back().length * model.trunk.back().axis);
+  truth.trunk.points.push_back(model.trunk.back().center +
+                               0.5 * model.trunk.back().length * model.trunk.back().axis);
   truth.trunk.diameters.push_back(model.trunk.back().diameter);
   io::writeTextFile(dir.file("t.json"), io::truthToJson(truth));
-  ASSERT_EQ(run("evaluate_model", "--model " + dir.file("m.json") + " --truth " + dir.file("t.json") + " --json", &out), 0)
+  ASSERT_EQ(
+      run("evaluate_model",
+          "--model " + dir.file("m.json") + " --truth " + dir.file("t.json") + " --json", &out),
+      0)
       << out;
   EXPECT_NE(out.find("\"coverage\""), std::string::npos) << out;
   EXPECT_EQ(run("evaluate_model", "--model " + dir.file("m.json"), &out), 2) << out;
@@ -100,7 +122,8 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
   std::getline(lines, header);
   std::getline(lines, trunk);
   std::getline(lines, branch);
-  EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(trunk.begin(), trunk.end(), ','));
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','),
+            std::count(trunk.begin(), trunk.end(), ','));
   EXPECT_EQ(trunk.rfind("trunk,0,-1,100.000000", 0), 0u) << trunk;
   EXPECT_NE(branch.find(",90.00,"), std::string::npos) << branch;
   EXPECT_NE(branch.find(",0.400,0"), std::string::npos) << branch;

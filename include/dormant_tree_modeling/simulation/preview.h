@@ -4,6 +4,7 @@
 
 #include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/evaluation/ground_truth.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {
@@ -17,6 +18,12 @@ namespace simulation {
 /// @throws Error IO_FAILURE
 void renderPreview(const Cloud& cloud, const evaluation::GroundTruth& truth,
                    const std::string& path, int width = 800);
+
+/// @brief Render a front view of a cloud with a model's cylinders over it: trunk brown,
+/// primary branches green, pruning candidates red; framed on the model. Saved as PNG.
+/// @throws Error IO_FAILURE
+void renderModelPreview(const Cloud& cloud, const modeling::TreeModel& model,
+                        const std::string& path, int width = 800);
 
 /// @brief Write a 16-bit binary PGM of a range image in millimetres (0 = invalid).
 void writeRangePgm(const std::string& path, int rows, int cols, const float* ranges_m);
