@@ -187,6 +187,18 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
   return cyl;
 }
 
+double noiseFromRadialResiduals(std::vector<double> residuals) {
+  if (residuals.empty())
+    return 0.0;
+  const std::size_t mid = residuals.size() / 2;
+  std::nth_element(residuals.begin(), residuals.begin() + mid, residuals.end());
+  const double median = residuals[mid];
+  for (double& r : residuals)
+    r = std::abs(r - median);
+  std::nth_element(residuals.begin(), residuals.begin() + mid, residuals.end());
+  return 1.4826 * residuals[mid] * std::sqrt(1.5);
+}
+
 double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
                             double min_radius) {
   double sum = 0.0;

@@ -49,18 +49,12 @@ CylinderModel toModel(const Cylinder& c, int id, std::size_t inliers, std::size_
   return m;
 }
 
-/// Range-noise guess from a cluster's cylinder-fit residuals: 1.4826 MAD x sqrt(3/2) (see
-/// estimateNoiseSigma). The slices refine it later.
+/// Range-noise guess from a cluster's cylinder-fit residuals; the slices refine it later.
 double noiseGuess(const Points& pts, const Cluster& cluster) {
   std::vector<double> res;
   for (const int i : cluster.members)
     res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
-  std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
-  const double med = res[res.size() / 2];
-  for (double& r : res)
-    r = std::abs(r - med);
-  std::nth_element(res.begin(), res.begin() + res.size() / 2, res.end());
-  return 1.4826 * res[res.size() / 2] * std::sqrt(1.5);
+  return noiseFromRadialResiduals(std::move(res));
 }
 
 /// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder

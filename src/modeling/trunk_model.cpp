@@ -403,10 +403,7 @@ double estimateNoiseSigma(const Points& pts, const Centerline& line,
   }
   if (residuals.size() < 200)
     return -1.0;
-  const double m = median(residuals);
-  for (double& r : residuals)
-    r = std::abs(r - m);
-  return 1.4826 * median(residuals) * std::sqrt(1.5);
+  return noiseFromRadialResiduals(std::move(residuals));
 }
 
 std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height,

@@ -120,7 +120,6 @@ void TreeModelerNode::workerLoop() {
         return;
       cloud = pending_;
       pending_.reset();
-      busy_ = true;
     }
     try {
       ROS_INFO("tree_modeler: %s", process(*cloud).c_str());
@@ -129,8 +128,6 @@ void TreeModelerNode::workerLoop() {
     } catch (const std::exception& e) {
       ROS_ERROR("tree_modeler: %s", e.what());
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    busy_ = false;
   }
 }
 

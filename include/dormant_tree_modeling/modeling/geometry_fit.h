@@ -105,6 +105,11 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
                                         double sigma, double scatter, double max_radius,
                                         std::uint64_t seed, std::vector<int>* inliers = nullptr);
 
+/// @brief Range noise from the radial residuals (d - r) of a circle or cylinder fit:
+/// 1.4826 MAD x sqrt(3/2), because a return's radial residual carries on average 2/3 of its
+/// range variance (incidence over a visible half-circle). 0 for no residuals.
+double noiseFromRadialResiduals(std::vector<double> residuals);
+
 /// @brief Deterministic k-means with k-means++ seeding from `seed`.
 /// @param pts points
 /// @param k clusters (clamped to the number of points)

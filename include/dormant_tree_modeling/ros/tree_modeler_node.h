@@ -48,7 +48,6 @@ class TreeModelerNode {
   std::condition_variable wake_;
   sensor_msgs::PointCloud2ConstPtr pending_;  // waiting to be modeled
   sensor_msgs::PointCloud2ConstPtr last_;     // last cloud received, for ~model_tree
-  bool busy_ = false;
   bool stop_ = false;
   std::thread worker_;
 };
