@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 
@@ -39,9 +40,10 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
   k = static_cast<int>(centres.size());
   std::vector<Eigen::Vector3d> sums(k);
   std::vector<int> counts(k);
+  std::vector<char> moved(n, 0);
   for (int it = 0; it < max_iterations; ++it) {
-    bool changed = false;
-    for (int i = 0; i < n; ++i) {
+    // Assignment: independent per point, so it runs on every core with identical results.
+    parallelFor(n, [&](int i) {
       int best = 0;
       double best_d = std::numeric_limits<double>::infinity();
       for (int c = 0; c < k; ++c) {
@@ -51,9 +53,10 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
           best = c;
         }
       }
-      changed = changed || labels[i] != best;
+      moved[i] = labels[i] != best;
       labels[i] = best;
-    }
+    });
+    const bool changed = std::find(moved.begin(), moved.end(), 1) != moved.end();
     std::fill(sums.begin(), sums.end(), Eigen::Vector3d::Zero());
     std::fill(counts.begin(), counts.end(), 0);
     for (int i = 0; i < n; ++i) {

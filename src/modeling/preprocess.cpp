@@ -5,6 +5,7 @@
 #include <map>
 #include <tuple>
 
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
@@ -101,19 +102,24 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points.
   const PointIndex index(pts);
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);
-  std::vector<int> candidates;
-  for (std::size_t i = 0; i < pts.size(); i += stride) {
+  const int samples = static_cast<int>((pts.size() + stride - 1) / stride);
+  std::vector<char> linear(samples, 0);
+  parallelFor(samples, [&](int k) {
+    const std::size_t i = static_cast<std::size_t>(k) * stride;
     const auto nn = index.within(pts[i], WIRE_NEIGHBOURHOOD);
     if (nn.size() < 8)
-      continue;
+      return;
     Points local;
     for (const int j : nn)
       local.push_back(pts[j]);
     Eigen::Vector3d eig;
     const Eigen::Vector3d dir = principalAxis(local, nullptr, &eig);
-    if (eig(1) < WIRE_LINEARITY * eig(2) && std::abs(dir.z()) < std::sin(WIRE_MAX_TILT)) {
-      candidates.push_back(static_cast<int>(i));
-    }
+    linear[k] = eig(1) < WIRE_LINEARITY * eig(2) && std::abs(dir.z()) < std::sin(WIRE_MAX_TILT);
+  });
+  std::vector<int> candidates;
+  for (int k = 0; k < samples; ++k) {
+    if (linear[k])
+      candidates.push_back(static_cast<int>(static_cast<std::size_t>(k) * stride));
   }
   std::size_t removed = 0;
   Rng rng(seed);
@@ -220,9 +226,9 @@ Points voxelDownsample(const Points& pts, double voxel) {
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
   std::vector<char> mask(pts.size(), 0);
   const PointIndex index(pts);
-  for (std::size_t i = 0; i < pts.size(); ++i) {
+  parallelFor(static_cast<int>(pts.size()), [&](int i) {
     mask[i] = index.countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
-  }
+  });
   return mask;
 }
 
