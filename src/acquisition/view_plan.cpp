@@ -1,12 +1,10 @@
 #include "dormant_tree_modeling/acquisition/view_plan.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
-#include <filesystem>
 
 #include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/yaml_map.h"
 
 namespace dormant_tree_modeling {
 namespace acquisition {
@@ -68,46 +66,34 @@ std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {
 }
 
 ViewPlanConfig loadViewPlan(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error(ErrorCode::FILE_NOT_FOUND, "no such file: " + path);
-  }
   ViewPlanConfig c;
-  try {
-    const YAML::Node n = YAML::LoadFile(path);
-    if (!n.IsMap())
-      throw Error(ErrorCode::PARSE_ERROR, path + ": view plan must be a YAML map");
-    for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
-      const YAML::Node& v = kv.second;
-      if (key == "heights")
-        c.heights = v.as<std::vector<double>>();
-      else if (key == "positions_per_height")
-        c.positions_per_height = v.as<int>();
-      else if (key == "position_spacing")
-        c.position_spacing = v.as<double>();
-      else if (key == "slide_steps")
-        c.slide_steps = v.as<int>();
-      else if (key == "slide_step")
-        c.slide_step = v.as<double>();
-      else if (key == "standoff")
-        c.standoff = v.as<double>();
-      else if (key == "front")
-        c.front = v.as<bool>();
-      else if (key == "back")
-        c.back = v.as<bool>();
-      else if (key == "theta_min_deg")
-        c.theta_min_deg = v.as<double>();
-      else if (key == "theta_max_deg")
-        c.theta_max_deg = v.as<double>();
-      else if (key == "theta_step_deg")
-        c.theta_step_deg = v.as<double>();
-      else
-        throw Error(ErrorCode::PARSE_ERROR, path + ": unknown view plan key '" + key + "'");
-    }
-  } catch (const YAML::Exception& e) {
-    throw Error(ErrorCode::PARSE_ERROR, path + ": " + e.what());
-  }
+  forEachYamlEntry(path, "", "view plan key", [&c](const std::string& key, const YAML::Node& v) {
+    if (key == "heights")
+      c.heights = v.as<std::vector<double>>();
+    else if (key == "positions_per_height")
+      c.positions_per_height = v.as<int>();
+    else if (key == "position_spacing")
+      c.position_spacing = v.as<double>();
+    else if (key == "slide_steps")
+      c.slide_steps = v.as<int>();
+    else if (key == "slide_step")
+      c.slide_step = v.as<double>();
+    else if (key == "standoff")
+      c.standoff = v.as<double>();
+    else if (key == "front")
+      c.front = v.as<bool>();
+    else if (key == "back")
+      c.back = v.as<bool>();
+    else if (key == "theta_min_deg")
+      c.theta_min_deg = v.as<double>();
+    else if (key == "theta_max_deg")
+      c.theta_max_deg = v.as<double>();
+    else if (key == "theta_step_deg")
+      c.theta_step_deg = v.as<double>();
+    else
+      return false;
+    return true;
+  });
   c.validate();
   return c;
 }

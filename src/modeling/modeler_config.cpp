@@ -1,13 +1,11 @@
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 
-#include <yaml-cpp/yaml.h>
-
-#include <filesystem>
 #include <functional>
 #include <map>
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/yaml_map.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -126,33 +124,15 @@ void ModelerConfig::validate() const {
 }
 
 ModelerConfig loadModelerConfig(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error(ErrorCode::FILE_NOT_FOUND, "no such file: " + path);
-  }
   ModelerConfig config;
-  try {
-    YAML::Node root = YAML::LoadFile(path);
-    if (root.IsMap() && root["tree_modeler"])
-      root = root["tree_modeler"];
-    if (!root.IsMap())
-      throw Error(ErrorCode::PARSE_ERROR, path + ": expected a map of parameters");
-    for (const auto& kv : root) {
-      const std::string key = kv.first.as<std::string>();
-      const auto it = setters().find(key);
-      if (it == setters().end()) {
-        throw Error(ErrorCode::PARSE_ERROR,
-                    path + ": unknown tree modeler parameter '" + key + "'");
-      }
-      try {
-        it->second(config, kv.second);
-      } catch (const YAML::Exception&) {
-        throw Error(ErrorCode::PARSE_ERROR, path + ": parameter '" + key + "' has the wrong type");
-      }
-    }
-  } catch (const YAML::Exception& e) {
-    throw Error(ErrorCode::PARSE_ERROR, path + ": " + e.what());
-  }
+  forEachYamlEntry(path, "tree_modeler", "tree modeler parameter",
+                   [&](const std::string& key, const YAML::Node& v) {
+                     const auto it = setters().find(key);
+                     if (it == setters().end())
+                       return false;
+                     it->second(config, v);
+                     return true;
+                   });
   config.validate();
   return config;
 }
