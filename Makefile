@@ -1,20 +1,23 @@
 # Entry points of the project. `make test` on a fresh clone installs, builds and tests.
 SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
-WS := $(ROOT)/.ws
+# Standalone catkin build of this one package: .build/cmake (CMake tree), .build/devel (devel
+# space; `source .build/devel/setup.bash`). Not build/: rosrun ignores a package's build/.
+BUILD := $(ROOT)/.build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc)
 # The python3 on some PATHs is not Debian's; catkin needs Debian's (catkin_pkg, empy).
 PYTHON := /usr/bin/python3
-CATKIN_ARGS := -DPYTHON_EXECUTABLE=$(PYTHON) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCATKIN_ENABLE_TESTING=ON
-SOURCES = $(shell cd $(ROOT) && git ls-files -co --exclude-standard -- '*.cpp' '*.h' | grep -v '^\.ws/')
+CMAKE_ARGS := -DPYTHON_EXECUTABLE=$(PYTHON) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DCATKIN_ENABLE_TESTING=ON \
+	-DCATKIN_DEVEL_PREFIX=$(BUILD)/devel
+SOURCES = $(shell cd $(ROOT) && git ls-files -co --exclude-standard -- '*.cpp' '*.h')
 
 .PHONY: all setup build test bench demo format format-check lint clean help
 
 all: build
 
 help:
-	@echo "make setup         install Debian packages, create the catkin workspace (.ws/)"
+	@echo "make setup         install the Debian packages the project needs"
 	@echo "make build         build everything (BUILD_TYPE=$(BUILD_TYPE))"
 	@echo "make test          setup + build + every gtest and rostest; ends 'N passed, N failed'"
 	@echo "make bench         setup + build + benchmarks (timings, memory, accuracy tables)"
@@ -23,24 +26,26 @@ help:
 	@echo "make format-check  fail on any badly formatted source; check the core has no ROS"
 	@echo "make clean         remove the build (keeps installed packages)"
 
-setup: $(WS)/.setup-stamp
+setup: $(BUILD)/.setup-stamp
 
-$(WS)/.setup-stamp: scripts/setup.sh scripts/debian-packages.txt
+$(BUILD)/.setup-stamp: scripts/setup.sh scripts/debian-packages.txt
 	bash scripts/setup.sh
+	mkdir -p $(BUILD)
 	touch $@
 
 build: setup
-	cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS)
+	cmake -S $(ROOT) -B $(BUILD)/cmake $(CMAKE_ARGS) > $(BUILD)/cmake.log || (cat $(BUILD)/cmake.log; false)
+	$(MAKE) -C $(BUILD)/cmake -j$(JOBS)
 
 test: build
-	rm -rf $(WS)/build/test_results
-	$(MAKE) -C $(WS)/build -j$(JOBS) tests
-	-$(MAKE) -C $(WS)/build -j1 run_tests
-	$(PYTHON) scripts/test_summary.py $(WS)/build/test_results
+	rm -rf $(BUILD)/cmake/test_results
+	$(MAKE) -C $(BUILD)/cmake -j$(JOBS) tests
+	-$(MAKE) -C $(BUILD)/cmake -j1 run_tests
+	$(PYTHON) scripts/test_summary.py $(BUILD)/cmake/test_results
 
 bench: build
-	$(MAKE) -C $(WS)/build -j$(JOBS) benchmarks
-	bash scripts/run_benchmarks.sh $(WS)/devel/lib/dormant_tree_modeling
+	$(MAKE) -C $(BUILD)/cmake -j$(JOBS) benchmarks
+	bash scripts/run_benchmarks.sh $(BUILD)/devel/lib/dormant_tree_modeling
 
 demo: build
 	bash scripts/demo.sh
@@ -55,4 +60,4 @@ format-check: setup
 lint: format-check
 
 clean:
-	rm -rf $(WS)/build $(WS)/devel
+	rm -rf $(BUILD)/cmake $(BUILD)/devel $(BUILD)/cmake.log

@@ -4,7 +4,7 @@
 # (The full ROS graph against the virtual platform joins this demo with the integration work.)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bin="$root/.ws/devel/lib/dormant_tree_modeling"
+bin="$root/.build/devel/lib/dormant_tree_modeling"
 preset="${DEMO_PRESET:-young_tall_spindle}"
 seed="${DEMO_SEED:-1}"
 noise="${DEMO_NOISE_MM:-6}"

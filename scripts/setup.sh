@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian packages of scripts/debian-packages.txt (skipping apt when all are
-# present) and creates the catkin workspace .ws/ whose src/ links this repository.
-# Works as root, or as a user with sudo.
+# Installs the Debian packages of scripts/debian-packages.txt, skipping apt when all are
+# present. Works as root, or as a user with sudo. (The build itself goes to .build/, see the
+# Makefile: a standalone catkin build of this package.)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -29,9 +29,3 @@ else
   echo "setup: all ${#packages[@]} Debian packages present"
 fi
 
-mkdir -p "$root/.ws/src"
-link="$root/.ws/src/dormant_tree_modeling"
-if [[ ! -L "$link" ]]; then
-  ln -sfn ../.. "$link"
-fi
-echo "setup: catkin workspace at $root/.ws"
