@@ -146,12 +146,21 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
     }
     if (minor) {
       ++s.ignored;
+      s.ignored_detections.push_back(d);
     } else {
       ++s.fp;
+      s.false_positives.push_back(d);
     }
   }
   s.tp = static_cast<int>(s.matches.size());
   s.fn = s.pb - s.tp;
+  std::vector<char> found(s.pb, 0);
+  for (const auto& m : s.matches)
+    found[m.truth] = 1;
+  for (int t = 0; t < s.pb; ++t) {
+    if (!found[t])
+      s.missed.push_back(t);
+  }
   s.ipb = detections - s.ignored;
   if (s.tp > 0) {
     s.branch_mae /= s.tp;

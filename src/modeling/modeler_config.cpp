@@ -70,11 +70,28 @@ const std::map<std::string, Setter>& setters() {
       {"wire_min_length", setter(&C::wire_min_length)},
       {"prune_ratio", setter(&C::prune_ratio)},
       {"seed", setter(&C::seed)},
+      {"trunk_calibration_radii",
+       [](C& c, const YAML::Node& n) { c.trunk_calibration.radii = n.as<std::vector<double>>(); }},
+      {"trunk_calibration_noise",
+       [](C& c, const YAML::Node& n) { c.trunk_calibration.noise = n.as<std::vector<double>>(); }},
+      {"trunk_calibration_bias",
+       [](C& c, const YAML::Node& n) { c.trunk_calibration.bias = n.as<std::vector<double>>(); }},
   };
   return table;
 }
 
 }  // namespace
+
+RadiusCalibration defaultTrunkCalibration() {
+  // calibrate_diameters --radii-mm 5,7.5,10,15,20,30,45,70,100 --noise-mm 3,6,12
+  RadiusCalibration c;
+  c.radii = {0.005, 0.0075, 0.01, 0.015, 0.02, 0.03, 0.045, 0.07, 0.1};
+  c.noise = {0.00415, 0.00610, 0.00882};
+  c.bias = {0.00449, 0.00483, 0.00362, 0.00225, 0.00201, 0.00104, 0.00030, 0.00016, 0.00005,
+            0.00716, 0.00562, 0.00392, 0.00424, 0.00343, 0.00242, 0.00157, 0.00105, 0.00060,
+            0.00750, 0.00607, 0.00410, 0.00389, 0.00423, 0.00292, 0.00263, 0.00183, 0.00134};
+  return c;
+}
 
 ModelerConfig ModelerConfig::paper() {
   ModelerConfig c;
@@ -121,6 +138,20 @@ void ModelerConfig::validate() const {
   check("floating_min_neighbors", floating_min_neighbors, 1, 1000);
   check("wire_min_length", wire_min_length, 0.1, 100.0);
   check("prune_ratio", prune_ratio, 0.0, 10.0);
+  const auto& cal = trunk_calibration;
+  if (!(cal.radii.empty() && cal.noise.empty() && cal.bias.empty())) {
+    if (!cal.valid()) {
+      throw Error(ErrorCode::INVALID_ARGUMENT,
+                  "tree modeler parameters trunk_calibration_*: radii and noise must be "
+                  "ascending and non-empty, bias must hold noise x radii = " +
+                      std::to_string(cal.noise.size() * cal.radii.size()) + " values (has " +
+                      std::to_string(cal.bias.size()) + ")");
+    }
+    for (const double b : cal.bias)
+      check("trunk_calibration_bias", b, -0.05, 0.05);
+    check("trunk_calibration_radii", cal.radii.front(), 1e-4, 1.0);
+    check("trunk_calibration_noise", cal.noise.front(), 0.0, 0.1);
+  }
 }
 
 ModelerConfig loadModelerConfig(const std::string& path) {

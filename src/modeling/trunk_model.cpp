@@ -116,27 +116,17 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
       sl.radius = circle->radius;
       sl.center = origin + circle->center.x() * u + circle->center.y() * v;
       sl.corrected_radius = sl.radius;
-      if (sigma > 0.0) {
-        // Second moment inside a window of radius + 1.5 sigma, iterated: branches leaving the
-        // trunk only add points outside the surface, so a tight outer window keeps most of
-        // them out. For a radial scatter truncated at +1.5 sigma the moment is
-        // (r - 0.139 sigma)^2 + 0.773 sigma^2 (truncated normal), solved here for r.
-        double r = sl.radius;
-        for (int round = 0; round < 4; ++round) {
-          double sum = 0.0;
-          int count_in = 0;
-          for (const auto& q : plane) {
-            const double d = (q - circle->center).norm();
-            if (d < r + 1.5 * sigma) {
-              sum += d * d;
-              ++count_in;
-            }
-          }
-          if (count_in == 0)
-            break;
-          r = 0.139 * sigma + std::sqrt(std::max(0.0, sum / count_in - 0.773 * sigma * sigma));
+      if (config.ours_correct_noise_bias) {
+        // The surface under the branch bases: the mode of the distances from the centre.
+        if (const auto surface = surfaceCircle(plane, *circle, threshold / 2.5, bounds.min_radius,
+                                               bounds.max_radius)) {
+          sl.radius = surface->radius;
+          sl.center = origin + surface->center.x() * u + surface->center.y() * v;
+          // The beam footprint's wings widen thin sections: the calibration takes them off.
+          sl.corrected_radius =
+              sigma > 0.0 ? config.trunk_calibration.correct(sl.radius, sigma, MIN_TRUNK_RADIUS)
+                          : sl.radius;
         }
-        sl.corrected_radius = r;
       }
     }
   }
@@ -479,7 +469,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     const auto expected = expectedRadii(slices);
     slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
                            config.ours_constrain_ransac ? &expected : nullptr,
-                           config.radius_continuity, scatter, config);
+                           config.radius_continuity, std::max(sigma, 1e-6), config);
   }
   trunk.slices = slices;
   trunk.centerline = line;

@@ -13,12 +13,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> models, truths;
   po::options_description desc(
       "Usage: evaluate_model --model model.json --truth truth.json [--model M2 --truth T2 ...] "
-      "[--json]\n"
+      "[--json | --details]\n"
       "Prints PB, IPB, FP rate, FN rate, F1, branch and trunk diameter MAE, coverage, runtime");
   desc.add_options()("help,h", "this help")("model,m", po::value(&models)->composing(),
                                             "model JSON (repeatable)")(
       "truth,t", po::value(&truths)->composing(), "truth JSON, paired in order with --model")(
-      "json", "machine-readable output");
+      "json", "machine-readable output")(
+      "details",
+      "also list each detection (TP, FP, ignored), each missed branch, each trunk "
+      "cylinder with its errors");
   try {
     po::variables_map vm;
     po::store(po::parse_command_line(argc, argv, desc), vm);
@@ -33,8 +36,12 @@ int main(int argc, char** argv) {
     }
     std::vector<evaluation::TreeScore> scores;
     for (std::size_t i = 0; i < models.size(); ++i) {
-      auto s = evaluation::evaluate(io::readModelFile(models[i]), io::readTruthFile(truths[i]));
+      const auto model = io::readModelFile(models[i]);
+      const auto truth = io::readTruthFile(truths[i]);
+      auto s = evaluation::evaluate(model, truth);
       s.name = models[i];
+      if (vm.count("details"))
+        std::cout << evaluation::formatDetails(s, model, truth);
       if (s.name.size() > 28)
         s.name = "..." + s.name.substr(s.name.size() - 25);
       scores.push_back(s);

@@ -63,8 +63,9 @@ TEST(Circle, RansacIgnoresOutliersAndRespectsBounds) {
   EXPECT_LE(inliers.size(), 215u);
   o.max_radius = 0.03;  // no circle of that size fits the ring
   const auto small = ransacCircle(pts, o);
-  if (small)
+  if (small) {
     EXPECT_LE(small->radius, 0.03);
+  }
 }
 
 TEST(Cylinder, LeastSquaresRecoversAnInclinedCylinder) {

@@ -167,8 +167,9 @@ TEST(TrunkModel, TaperedTrunkWithBranchesGivesSegmentsAndRadii) {
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
     const auto& c = trunk.cylinders[i];
     const double expected = c.center.z() < 0.6 ? 0.04 : 0.03;
-    if (std::abs(c.center.z() - 0.6) > 0.2)
+    if (std::abs(c.center.z() - 0.6) > 0.2) {
       EXPECT_NEAR(c.radius, expected, 0.002) << "segment " << i;
+    }
     EXPECT_GT(c.axis.z(), 0.99);
   }
   // The outlier curve rises at both branch heights.
@@ -236,6 +237,11 @@ TEST(ModelerConfig, ShippedConfigLoads) {
       loadModelerConfig(std::string(DTM_TEST_DATA_DIR) + "/../../config/tree_modeler.yaml");
   EXPECT_DOUBLE_EQ(c.psi_t, 72.0);
   EXPECT_TRUE(c.ours_follow_diameter);
+  // The shipped file and the compiled-in defaults carry the same calibration table.
+  const RadiusCalibration d = defaultTrunkCalibration();
+  EXPECT_EQ(c.trunk_calibration.radii, d.radii);
+  EXPECT_EQ(c.trunk_calibration.noise, d.noise);
+  EXPECT_EQ(c.trunk_calibration.bias, d.bias);
 }
 
 }  // namespace

@@ -58,6 +58,9 @@ struct TreeScore {
   double coverage = 0.0;                                          ///< 0..1
   double runtime_s = 0.0;
   std::vector<BranchMatch> matches;
+  std::vector<int> false_positives;     ///< indices into model.primary_branches
+  std::vector<int> ignored_detections;  ///< near a minor branch only
+  std::vector<int> missed;              ///< indices into truth.primary_branches (FN)
 };
 
 /// @brief Score a model against ground truth exactly as docs/evaluation.md defines.
@@ -66,6 +69,12 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
 
 /// @brief A Table-3-style text table: one row per tree and, for more than one, a mean row.
 std::string formatTable(const std::vector<TreeScore>& scores);
+
+/// @brief Per detection and per true branch, why it counted as it did: TP with its errors,
+/// FP with the nearest true branch, ignored, FN with the nearest detection; and per trunk
+/// cylinder its height, detected and true diameter. For finding what a model gets wrong.
+std::string formatDetails(const TreeScore& score, const modeling::TreeModel& model,
+                          const GroundTruth& truth);
 
 /// @brief The scores as JSON (an object for one tree, with a "mean" for several).
 std::string scoresToJson(const std::vector<TreeScore>& scores);

@@ -54,6 +54,18 @@ struct CircleRansacOptions {
 std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions& options,
                                    std::vector<int>* inliers = nullptr);
 
+/// @brief The circle of a solid cross-section's surface when other things (branch bases,
+/// shoots) add points outside it: the radius is the mode of the points' distances from the
+/// centre (Gaussian kernel, bandwidth 0.6 sigma), the centre a least-squares fit with that
+/// radius held over the points of the mode; alternated until both settle. A least-squares or
+/// RANSAC circle with a band as wide as the noise drifts outwards onto such points.
+/// @param start centre and radius to start from (a RANSAC circle)
+/// @param sigma range noise (m): the kernel bandwidth and the band of the centre fit
+/// @param min_radius, max_radius where the mode is searched (m)
+/// @returns nothing for fewer than 3 points or empty bounds
+std::optional<Circle> surfaceCircle(const Points2& pts, const Circle& start, double sigma,
+                                    double min_radius, double max_radius);
+
 /// @brief Geometric least-squares cylinder (Gauss-Newton on axis, centre and radius) from an
 /// initial axis direction; the start comes from a circle fit in the plane orthogonal to it.
 /// @param pts at least 6 points

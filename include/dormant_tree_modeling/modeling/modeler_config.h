@@ -3,8 +3,13 @@
 #include <cstdint>
 #include <string>
 
+#include "dormant_tree_modeling/modeling/radius_calibration.h"
+
 namespace dormant_tree_modeling {
 namespace modeling {
+
+/// @brief The trunk radius calibration shipped in config/tree_modeler.yaml.
+RadiusCalibration defaultTrunkCalibration();
 
 /// @brief Every parameter of the tree modeler. Defaults are the paper's values (Medeiros et
 /// al., docs/algorithms.md) where the paper tuned one; the `ours_*` switches turn on what we
@@ -49,6 +54,12 @@ struct ModelerConfig {
   /// working range (8 mm + 15 mrad, SICK LMS1xx manual 3.6.2), calibrated on the sensor model;
   /// re-calibrate against calipers in the field, 0 for an ideal beam.
   double beam_spread = 0.012;
+  /// Trunk radius calibration (apparent minus true radius over true radius and estimated
+  /// noise), applied to every trunk slice when ours_correct_noise_bias is on. YAML keys
+  /// trunk_calibration_radii, trunk_calibration_noise, trunk_calibration_bias (m); empty lists:
+  /// no correction. Default: made by `calibrate_diameters` on the LMS111 model with the
+  /// paper's 40-view plan (config/tree_modeler.yaml); re-make it from field references.
+  RadiusCalibration trunk_calibration = defaultTrunkCalibration();
 
   double trunk_max_tilt = 30.0;  ///< trunk cylinders' axes within this of vertical
   double radius_continuity =

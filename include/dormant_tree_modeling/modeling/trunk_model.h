@@ -40,8 +40,8 @@ struct Slice {
   bool has_circle = false;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< circle centre in 3-D
   double radius = 0.0;
-  /// Radius corrected for range noise, sqrt(mean d^2 - sigma^2) over the slice's points closer
-  /// than radius + 2.5 sigma to the centre (equals radius when no noise estimate was given).
+  /// Radius with the sensor's systematic error taken off (ModelerConfig::trunk_calibration);
+  /// equals radius when no noise estimate was given or the correction is off.
   double corrected_radius = 0.0;
 };
 

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <vector>
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief Systematic radius error of the trunk's slice estimate, apparent minus true, as a
+/// table over the true radius and the range noise the modeler estimates. A laser beam that
+/// partly hits a thin object reports its range along the beam centre, so each silhouette edge
+/// gains returns up to a beam radius outside the surface (the footprint "wings"); the thinner
+/// the object, the larger their share. Built by `calibrate_diameters` from reference cylinders
+/// (simulated with the LMS111 model, or scanned in the field and measured with calipers).
+struct RadiusCalibration {
+  std::vector<double> radii;  ///< true radii, ascending (m)
+  std::vector<double> noise;  ///< estimated range noise of each row, ascending (m)
+  std::vector<double> bias;   ///< noise.size() rows of radii.size() values (m)
+
+  /// @brief Whether the table is usable (non-empty, consistent sizes, ascending axes).
+  bool valid() const;
+
+  /// @brief Bias at a true radius and noise, bilinear, held constant beyond the table.
+  double biasAt(double radius, double sigma) const;
+
+  /// @brief The true radius whose apparent radius is `apparent` (inversion of
+  /// apparent = r + bias(r, sigma)); `apparent` itself when the table is empty.
+  /// @param min_radius floor of the result (m)
+  double correct(double apparent, double sigma, double min_radius) const;
+};
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,72 @@
+#include "dormant_tree_modeling/modeling/radius_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+/// Index of the lower grid point and the fraction towards the next, clamped to the grid.
+std::pair<std::size_t, double> locate(const std::vector<double>& grid, double x) {
+  if (grid.size() < 2 || x <= grid.front())
+    return {0, 0.0};
+  if (x >= grid.back())
+    return {grid.size() - 2, 1.0};
+  const std::size_t i =
+      static_cast<std::size_t>(std::upper_bound(grid.begin(), grid.end(), x) - grid.begin()) - 1;
+  return {i, (x - grid[i]) / (grid[i + 1] - grid[i])};
+}
+
+bool ascending(const std::vector<double>& v) {
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    if (!(v[i] > v[i - 1]))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool RadiusCalibration::valid() const {
+  return !radii.empty() && !noise.empty() && bias.size() == radii.size() * noise.size() &&
+         ascending(radii) && ascending(noise);
+}
+
+double RadiusCalibration::biasAt(double radius, double sigma) const {
+  if (!valid())
+    return 0.0;
+  const std::size_t n = radii.size();
+  auto row = [&](std::size_t k) {
+    if (n == 1)
+      return bias[k * n];
+    const auto [i, t] = locate(radii, radius);
+    return (1.0 - t) * bias[k * n + i] + t * bias[k * n + i + 1];
+  };
+  if (noise.size() == 1)
+    return row(0);
+  const auto [k, u] = locate(noise, sigma);
+  return (1.0 - u) * row(k) + u * row(k + 1);
+}
+
+double RadiusCalibration::correct(double apparent, double sigma, double min_radius) const {
+  if (!valid())
+    return std::max(apparent, min_radius);
+  // apparent(r) = r + bias(r) rises with r in any sensible table; bisection finds its root
+  // even where the bias falls almost as fast as r grows (thin sections under heavy noise).
+  auto excess = [&](double r) { return r + biasAt(r, sigma) - apparent; };
+  double lo = min_radius, hi = std::max(apparent, min_radius) + 0.05;
+  if (excess(lo) >= 0.0)
+    return min_radius;
+  if (excess(hi) <= 0.0)
+    return std::max(apparent - biasAt(apparent, sigma), min_radius);
+  for (int it = 0; it < 50; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (excess(mid) < 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,116 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/radius_calibration.h"
+#include "dormant_tree_modeling/simulation/trunk_calibration.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+RadiusCalibration table() {
+  RadiusCalibration c;
+  c.radii = {0.01, 0.03};
+  c.noise = {0.002, 0.006};
+  c.bias = {0.004, 0.002,   // noise 2 mm
+            0.008, 0.004};  // noise 6 mm
+  return c;
+}
+
+TEST(RadiusCalibration, BilinearInsideAndHeldOutside) {
+  const RadiusCalibration c = table();
+  ASSERT_TRUE(c.valid());
+  EXPECT_NEAR(c.biasAt(0.01, 0.002), 0.004, 1e-12);
+  EXPECT_NEAR(c.biasAt(0.02, 0.002), 0.003, 1e-12);
+  EXPECT_NEAR(c.biasAt(0.02, 0.004), 0.0045, 1e-12);  // mean of 3 and 6 mm
+  EXPECT_NEAR(c.biasAt(0.005, 0.001), 0.004, 1e-12);  // below both axes: the corner
+  EXPECT_NEAR(c.biasAt(0.5, 0.5), 0.004, 1e-12);      // above both: the other corner
+}
+
+TEST(RadiusCalibration, CorrectInvertsTheTable) {
+  const RadiusCalibration c = table();
+  for (const double r : {0.01, 0.015, 0.02, 0.03, 0.05}) {
+    for (const double s : {0.002, 0.004, 0.006}) {
+      const double apparent = r + c.biasAt(r, s);
+      EXPECT_NEAR(c.correct(apparent, s, 0.001), r, 1e-9) << r << " " << s;
+    }
+  }
+  EXPECT_DOUBLE_EQ(c.correct(0.002, 0.002, 0.003), 0.003);                  // floor
+  EXPECT_DOUBLE_EQ(RadiusCalibration{}.correct(0.02, 0.004, 0.001), 0.02);  // empty: identity
+}
+
+TEST(RadiusCalibration, ConfigRejectsInconsistentTables) {
+  ModelerConfig config;
+  config.trunk_calibration = table();
+  EXPECT_NO_THROW(config.validate());
+  config.trunk_calibration.bias.pop_back();
+  EXPECT_THROW(config.validate(), Error);
+  config.trunk_calibration = table();
+  config.trunk_calibration.radii = {0.03, 0.01};
+  EXPECT_THROW(config.validate(), Error);
+  config.trunk_calibration = table();
+  config.trunk_calibration.bias[0] = 0.2;
+  EXPECT_THROW(config.validate(), Error);
+  config.trunk_calibration = {};
+  EXPECT_NO_THROW(config.validate());  // no table: no correction
+  EXPECT_TRUE(ModelerConfig{}.trunk_calibration.valid());
+}
+
+TEST(SurfaceCircle, IgnoresABranchBaseThatPullsLeastSquaresOutwards) {
+  // A trunk section of radius 30 mm seen all round with 3 mm noise, and a branch base: a
+  // blob of points from the surface 30 to 80 mm outwards on one side.
+  Rng rng(7);
+  Points2 pts;
+  for (int i = 0; i < 600; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI), r = 0.03 + rng.normal(0.0, 0.003);
+    pts.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  for (int i = 0; i < 400; ++i) {
+    const double a = rng.uniform(-0.3, 0.3), r = rng.uniform(0.03, 0.08);
+    pts.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  const auto ls = fitCircle(pts);
+  ASSERT_TRUE(ls);
+  EXPECT_GT(ls->radius, 0.034);  // the plain fit is pulled out
+  CircleRansacOptions o;
+  o.threshold = 0.0075;
+  o.min_radius = 0.01;
+  o.max_radius = 0.08;
+  const auto start = ransacCircle(pts, o);
+  ASSERT_TRUE(start);
+  const auto s = surfaceCircle(pts, *start, 0.003, 0.01, 0.08);
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->radius, 0.03, 0.0015);
+  EXPECT_LT(s->center.norm(), 0.0015);
+  EXPECT_FALSE(surfaceCircle({{0, 0}, {1, 0}}, *ls, 0.003, 0.01, 0.08));
+  EXPECT_FALSE(surfaceCircle(pts, *ls, 0.003, 0.08, 0.01));
+}
+
+TEST(TrunkCalibration, ThinPolesLookWiderThanThickOnes) {
+  // Two reference poles through a reduced plan (one platform position): the footprint wings
+  // widen the thin pole by more than the thick one, and the table holds what was measured.
+  simulation::TrunkCalibrationOptions o;
+  o.radii = {0.01, 0.05};
+  o.noise = {0.003};
+  o.plan.heights = {1.5};
+  o.plan.positions_per_height = 1;
+  o.plan.slide_steps = 2;
+  const auto result = simulation::calibrateTrunkRadii(o);
+  ASSERT_TRUE(result.calibration.valid());
+  ASSERT_EQ(result.calibration.bias.size(), 2u);
+  EXPECT_GT(result.calibration.bias[0], result.calibration.bias[1] + 0.001);
+  EXPECT_GT(result.calibration.bias[0], 0.0);
+  EXPECT_LT(result.calibration.bias[0], 0.012);  // at most about a beam radius
+  EXPECT_LT(std::abs(result.calibration.bias[1]), 0.004);
+  o.radii = {0.05, 0.01};
+  EXPECT_THROW(simulation::calibrateTrunkRadii(o), Error);
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
