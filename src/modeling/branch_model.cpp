@@ -161,9 +161,14 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     o.max_radius = config.ours_constrain_ransac ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : 0.3;
     o.seed = config.seed * 15485863ULL + stream++;
     std::vector<int> inliers;
-    auto cyl = config.ours_constrain_ransac
-                   ? fitThinCylinder(sub, axis, sigma, scatter, o.max_radius, o.seed, &inliers)
-                   : ransacCylinder(sub, axis, o, &inliers);
+    // With a branch calibration the fit reports the raw RMS radius and the table maps it.
+    const bool calibrated = config.ours_correct_noise_bias && config.branch_calibration.valid();
+    const bool raw = calibrated || config.branch_raw_radius;
+    auto cyl = config.ours_constrain_ransac ? fitThinCylinder(sub, axis, sigma, raw ? 0.0 : scatter,
+                                                              o.max_radius, o.seed, &inliers)
+                                            : ransacCylinder(sub, axis, o, &inliers);
+    if (cyl && calibrated && !config.branch_raw_radius && config.ours_constrain_ransac)
+      cyl->radius = config.branch_calibration.correct(cyl->radius, sigma, MIN_BRANCH_RADIUS);
     if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points)
       continue;
     if (cyl->axis.dot(radial) < 0.0)

@@ -314,15 +314,27 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
         cyl.axis = d;
       }
     }
-    std::map<long, std::pair<double, int>> moments_by_slice;
+    std::map<long, std::vector<double>> sq_by_slice;
     for (const int i : used) {
       const double dist = axisDistance(cyl, pts[i]);
-      if (dist >= reach)
-        continue;
-      auto& m = moments_by_slice[static_cast<long>(
-          std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))];
-      m.first += dist * dist;
-      ++m.second;
+      if (dist < reach)
+        sq_by_slice[static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))]
+            .push_back(dist * dist);
+    }
+    // The raw moment (for a calibration) leaves out each slice's farthest fifth: spurs and
+    // shoots on the branch. The calibration absorbs what the trimming takes from the scatter.
+    std::map<long, std::pair<double, int>> moments_by_slice;
+    for (auto& kv : sq_by_slice) {
+      auto& v = kv.second;
+      std::size_t keep = v.size();
+      if (scatter <= 0.0 && v.size() >= 5) {
+        keep = (v.size() * 4 + 4) / 5;
+        std::nth_element(v.begin(), v.begin() + (keep - 1), v.end());
+      }
+      auto& m = moments_by_slice[kv.first];
+      for (std::size_t k = 0; k < keep; ++k)
+        m.first += v[k];
+      m.second = static_cast<int>(keep);
     }
     std::vector<double> moments;
     double total = 0.0;
@@ -340,8 +352,11 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
       std::nth_element(moments.begin(), moments.begin() + moments.size() / 2, moments.end());
       moment = moments[moments.size() / 2];
     }
-    radius =
-        std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_RADIUS, max_radius);
+    // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
+    // it may exceed the radius bound by the scatter it carries.
+    const double upper =
+        scatter > 0.0 ? max_radius : max_radius + 2.5 * std::max(sigma, 0.004) + 0.002;
+    radius = std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_RADIUS, upper);
   }
   cyl.radius = radius;
   const int count = static_cast<int>(used.size());

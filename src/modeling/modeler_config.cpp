@@ -22,6 +22,23 @@ void check(const char* name, T value, T lo, T hi) {
   }
 }
 
+void checkCalibration(const std::string& name, const RadiusCalibration& cal) {
+  if (cal.radii.empty() && cal.noise.empty() && cal.bias.empty())
+    return;  // no table: no correction
+  if (!cal.valid()) {
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "tree modeler parameters " + name +
+                    "_*: radii and noise must be ascending and non-empty, bias must hold noise x "
+                    "radii = " +
+                    std::to_string(cal.noise.size() * cal.radii.size()) + " values (has " +
+                    std::to_string(cal.bias.size()) + ")");
+  }
+  for (const double b : cal.bias)
+    check((name + "_bias").c_str(), b, -0.05, 0.05);
+  check((name + "_radii").c_str(), cal.radii.front(), 1e-4, 1.0);
+  check((name + "_noise").c_str(), cal.noise.front(), 0.0, 0.1);
+}
+
 using Setter = std::function<void(ModelerConfig&, const YAML::Node&)>;
 
 template <typename T>
@@ -70,12 +87,19 @@ const std::map<std::string, Setter>& setters() {
       {"wire_min_length", setter(&C::wire_min_length)},
       {"prune_ratio", setter(&C::prune_ratio)},
       {"seed", setter(&C::seed)},
+      {"branch_raw_radius", setter(&C::branch_raw_radius)},
       {"trunk_calibration_radii",
        [](C& c, const YAML::Node& n) { c.trunk_calibration.radii = n.as<std::vector<double>>(); }},
       {"trunk_calibration_noise",
        [](C& c, const YAML::Node& n) { c.trunk_calibration.noise = n.as<std::vector<double>>(); }},
       {"trunk_calibration_bias",
        [](C& c, const YAML::Node& n) { c.trunk_calibration.bias = n.as<std::vector<double>>(); }},
+      {"branch_calibration_radii",
+       [](C& c, const YAML::Node& n) { c.branch_calibration.radii = n.as<std::vector<double>>(); }},
+      {"branch_calibration_noise",
+       [](C& c, const YAML::Node& n) { c.branch_calibration.noise = n.as<std::vector<double>>(); }},
+      {"branch_calibration_bias",
+       [](C& c, const YAML::Node& n) { c.branch_calibration.bias = n.as<std::vector<double>>(); }},
   };
   return table;
 }
@@ -90,6 +114,17 @@ RadiusCalibration defaultTrunkCalibration() {
   c.bias = {0.00449, 0.00483, 0.00362, 0.00225, 0.00201, 0.00104, 0.00030, 0.00016, 0.00005,
             0.00716, 0.00562, 0.00392, 0.00424, 0.00343, 0.00242, 0.00157, 0.00105, 0.00060,
             0.00750, 0.00607, 0.00410, 0.00389, 0.00423, 0.00292, 0.00263, 0.00183, 0.00134};
+  return c;
+}
+
+RadiusCalibration defaultBranchCalibration() {
+  // calibrate_diameters --branch-radii-mm 3,4,5,6.5,8,10,12.5,15,20 --noise-mm 3,6,12
+  RadiusCalibration c;
+  c.radii = {0.00300, 0.00400, 0.00500, 0.00650, 0.00800, 0.01000, 0.01250, 0.01500, 0.02000};
+  c.noise = {0.00506, 0.00681, 0.00955};
+  c.bias = {0.00518, 0.00447, 0.00387, 0.00328, 0.00289, 0.00234, 0.00159, 0.00126, -0.00012,
+            0.00598, 0.00529, 0.00468, 0.00403, 0.00351, 0.00291, 0.00215, 0.00159, 0.00036,
+            0.00815, 0.00761, 0.00667, 0.00592, 0.00545, 0.00440, 0.00336, 0.00258, 0.00110};
   return c;
 }
 
@@ -138,20 +173,8 @@ void ModelerConfig::validate() const {
   check("floating_min_neighbors", floating_min_neighbors, 1, 1000);
   check("wire_min_length", wire_min_length, 0.1, 100.0);
   check("prune_ratio", prune_ratio, 0.0, 10.0);
-  const auto& cal = trunk_calibration;
-  if (!(cal.radii.empty() && cal.noise.empty() && cal.bias.empty())) {
-    if (!cal.valid()) {
-      throw Error(ErrorCode::INVALID_ARGUMENT,
-                  "tree modeler parameters trunk_calibration_*: radii and noise must be "
-                  "ascending and non-empty, bias must hold noise x radii = " +
-                      std::to_string(cal.noise.size() * cal.radii.size()) + " values (has " +
-                      std::to_string(cal.bias.size()) + ")");
-    }
-    for (const double b : cal.bias)
-      check("trunk_calibration_bias", b, -0.05, 0.05);
-    check("trunk_calibration_radii", cal.radii.front(), 1e-4, 1.0);
-    check("trunk_calibration_noise", cal.noise.front(), 0.0, 0.1);
-  }
+  checkCalibration("trunk_calibration", trunk_calibration);
+  checkCalibration("branch_calibration", branch_calibration);
 }
 
 ModelerConfig loadModelerConfig(const std::string& path) {

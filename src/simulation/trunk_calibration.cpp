@@ -10,7 +10,6 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
-#include "dormant_tree_modeling/simulation/scene.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
 
 namespace dormant_tree_modeling {
@@ -48,14 +47,16 @@ Scene poleScene(const std::vector<double>& radii, const TrunkCalibrationOptions&
   return scene;
 }
 
-/// Every view of the plan merged in the scene frame, cropped to the pole.
-modeling::Points scanPole(const Scene& scene, double noise, const TrunkCalibrationOptions& o,
-                          std::uint64_t seed) {
+}  // namespace
+
+std::vector<Eigen::Vector3d> scanReferenceScene(const Scene& scene, double noise,
+                                                const TrunkCalibrationOptions& o,
+                                                std::uint64_t seed, double crop_radius) {
   const RayCaster caster(scene);
   Lms111Config sensor = o.sensor;
   sensor.range_noise_sigma = noise;
   const Lms111Model model(caster, sensor);
-  modeling::Points pts;
+  std::vector<Eigen::Vector3d> pts;
   for (const auto& v : acquisition::makeViewPlan(o.plan)) {
     const Eigen::Isometry3d stage = acquisition::stagePose(v.platform, o.geometry, v.slide);
     const SimulatedView sim =
@@ -63,18 +64,16 @@ modeling::Points scanPole(const Scene& scene, double noise, const TrunkCalibrati
     const auto local = acquisition::toCloud(sim.image, 0.0, M_PI);
     for (const auto& p : local->points) {
       const Eigen::Vector3d q = stage * p.getVector3fMap().cast<double>();
-      if (std::hypot(q.x(), q.y()) < CROP_RADIUS && q.z() > 0.05)
+      if (std::hypot(q.x(), q.y()) < crop_radius && q.z() > 0.05)
         pts.push_back(q);
     }
   }
   return pts;
 }
 
-}  // namespace
-
-TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
+void checkCalibrationAxes(const TrunkCalibrationOptions& o) {
   auto ascending = [](const std::vector<double>& v) {
-    if (v.empty() || v.front() <= 0.0)
+    if (v.empty() || !(v.front() > 0.0))
       return false;
     for (std::size_t i = 1; i < v.size(); ++i) {
       if (!(v[i] > v[i - 1]))
@@ -85,6 +84,33 @@ TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
   if (!ascending(o.radii) || !ascending(o.noise))
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "calibration radii and noise levels must be positive and ascending");
+}
+
+void appendCalibrationRow(modeling::RadiusCalibration& table, std::vector<double> bias,
+                          const std::vector<char>& measured, double noise_axis) {
+  const std::vector<double> raw = bias;
+  for (std::size_t k = 0; k < bias.size(); ++k) {
+    if (measured[k])
+      continue;
+    for (std::size_t d = 1; d < bias.size(); ++d) {
+      if (k >= d && measured[k - d]) {
+        bias[k] = raw[k - d];
+        break;
+      }
+      if (k + d < bias.size() && measured[k + d]) {
+        bias[k] = raw[k + d];
+        break;
+      }
+    }
+  }
+  if (!table.noise.empty())
+    noise_axis = std::max(noise_axis, table.noise.back() + 1e-5);
+  table.noise.push_back(noise_axis);
+  table.bias.insert(table.bias.end(), bias.begin(), bias.end());
+}
+
+TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
+  checkCalibrationAxes(o);
   modeling::ModelerConfig config = o.modeler;
   config.trunk_calibration = {};
   config.ours_correct_noise_bias = true;
@@ -98,8 +124,8 @@ TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
     std::vector<std::vector<double>> apparent(o.radii.size()), estimate(o.radii.size());
     int order = 0;
     for (const auto* radii : {&o.radii, &descending}) {
-      const modeling::Points pts =
-          scanPole(poleScene(*radii, o), noise, o, o.seed * 1000 + level * 2 + order++);
+      const modeling::Points pts = scanReferenceScene(
+          poleScene(*radii, o), noise, o, o.seed * 1000 + level * 2 + order++, CROP_RADIUS);
       for (std::size_t b = 0; b < radii->size(); ++b) {
         const double r = (*radii)[b];
         const double z0 = o.base_height + b * o.band_height + BAND_MARGIN;
@@ -130,6 +156,7 @@ TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
     double sigma_sum = 0.0;
     int sigma_n = 0;
     std::vector<double> row(o.radii.size(), 0.0);
+    std::vector<char> measured(o.radii.size(), 0);
     for (std::size_t k = 0; k < o.radii.size(); ++k) {
       if (apparent[k].empty())
         continue;
@@ -141,32 +168,15 @@ TrunkCalibrationResult calibrateTrunkRadii(const TrunkCalibrationOptions& o) {
         s.noise_estimate += estimate[k][j] / estimate[k].size();
       }
       row[k] = s.apparent - s.radius;
+      measured[k] = 1;
       if (s.noise_estimate > 0.0) {
         sigma_sum += s.noise_estimate;
         ++sigma_n;
       }
       result.samples.push_back(s);
     }
-    // Radii that could not be measured take the nearest measured bias.
-    for (std::size_t k = 0; k < row.size(); ++k) {
-      if (!apparent[k].empty())
-        continue;
-      for (std::size_t d = 1; d < row.size(); ++d) {
-        if (k >= d && !apparent[k - d].empty()) {
-          row[k] = row[k - d];
-          break;
-        }
-        if (k + d < row.size() && !apparent[k + d].empty()) {
-          row[k] = row[k + d];
-          break;
-        }
-      }
-    }
-    double axis = sigma_n > 0 ? sigma_sum / sigma_n : noise;
-    if (!result.calibration.noise.empty())
-      axis = std::max(axis, result.calibration.noise.back() + 1e-5);
-    result.calibration.noise.push_back(axis);
-    result.calibration.bias.insert(result.calibration.bias.end(), row.begin(), row.end());
+    appendCalibrationRow(result.calibration, row, measured,
+                         sigma_n > 0 ? sigma_sum / sigma_n : noise);
   }
   return result;
 }

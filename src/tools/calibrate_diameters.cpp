@@ -8,7 +8,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/tree_json.h"
-#include "dormant_tree_modeling/simulation/trunk_calibration.h"
+#include "dormant_tree_modeling/simulation/branch_calibration.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
@@ -28,6 +28,17 @@ std::vector<double> parseList(const std::string& text, double scale) {
   return out;
 }
 
+void printSamples(const char* what, const simulation::TrunkCalibrationResult& result) {
+  std::cerr << what << ":\n  radius mm  sensor noise mm  apparent mm  bias mm  noise estimate mm\n";
+  for (const auto& s : result.samples) {
+    char line[160];
+    std::snprintf(line, sizeof(line), "  %9.1f  %15.1f  %11.2f  %+7.2f  %17.2f\n", 1000 * s.radius,
+                  1000 * s.sensor_noise, 1000 * s.apparent, 1000 * (s.apparent - s.radius),
+                  1000 * s.noise_estimate);
+    std::cerr << line;
+  }
+}
+
 std::string yamlList(const std::vector<double>& v) {
   std::string s = "[";
   char buf[32];
@@ -42,14 +53,19 @@ std::string yamlList(const std::vector<double>& v) {
 
 int main(int argc, char** argv) {
   simulation::TrunkCalibrationOptions opt;
-  std::string radii_mm = "5,7.5,10,15,20,30,45,70,100", noise_mm = "3,6,12", params, output;
+  std::string radii_mm = "5,7.5,10,15,20,30,45,70,100",
+              branch_radii_mm = "3,4,5,6.5,8,10,12.5,15,20", noise_mm = "3,6,12", params, output,
+              only;
   po::options_description desc(
-      "Usage: calibrate_diameters [--radii-mm LIST] [--noise-mm LIST] [--params FILE] "
-      "[--output FILE]\n"
-      "Scans reference poles with the LMS111 model and the 40-view plan, measures them with the "
-      "modeler's trunk step and prints the trunk_calibration_* keys of config/tree_modeler.yaml");
+      "Usage: calibrate_diameters [--radii-mm LIST] [--branch-radii-mm LIST] [--noise-mm LIST] "
+      "[--only trunk|branch] [--params FILE] [--output FILE]\n"
+      "Scans reference poles (trunk) and a reference tree of rods (branches) with the LMS111 "
+      "model and the 40-view plan, measures them with the modeler and prints the "
+      "trunk_calibration_* and branch_calibration_* keys of config/tree_modeler.yaml");
   desc.add_options()("help,h", "this help")(
       "radii-mm", po::value(&radii_mm)->default_value(radii_mm), "pole radii, mm, ascending")(
+      "branch-radii-mm", po::value(&branch_radii_mm)->default_value(branch_radii_mm),
+      "rod radii, mm, ascending")("only", po::value(&only), "trunk or branch: one table only")(
       "noise-mm", po::value(&noise_mm)->default_value(noise_mm),
       "range noise levels, mm, ascending")("params,p", po::value(&params),
                                            "modeler parameters, YAML (its trunk step settings)")(
@@ -63,24 +79,29 @@ int main(int argc, char** argv) {
       return 0;
     }
     po::notify(vm);
-    opt.radii = parseList(radii_mm, 1e-3);
+    if (!only.empty() && only != "trunk" && only != "branch")
+      throw po::error("--only takes trunk or branch");
     opt.noise = parseList(noise_mm, 1e-3);
     if (!params.empty())
       opt.modeler = modeling::loadModelerConfig(params);
-    const auto result = simulation::calibrateTrunkRadii(opt);
-    std::cerr << "  radius mm  sensor noise mm  apparent mm  bias mm  noise estimate mm\n";
-    for (const auto& s : result.samples) {
-      char line[160];
-      std::snprintf(line, sizeof(line), "  %9.1f  %15.1f  %11.2f  %+7.2f  %17.2f\n",
-                    1000 * s.radius, 1000 * s.sensor_noise, 1000 * s.apparent,
-                    1000 * (s.apparent - s.radius), 1000 * s.noise_estimate);
-      std::cerr << line;
+    std::string yaml = "  # calibrate_diameters --radii-mm " + radii_mm + " --branch-radii-mm " +
+                       branch_radii_mm + " --noise-mm " + noise_mm + "\n";
+    auto append = [&](const std::string& key, const modeling::RadiusCalibration& c) {
+      yaml += "  " + key + "_radii: " + yamlList(c.radii) + "\n  " + key +
+              "_noise: " + yamlList(c.noise) + "\n  " + key + "_bias: " + yamlList(c.bias) + "\n";
+    };
+    if (only != "branch") {
+      opt.radii = parseList(radii_mm, 1e-3);
+      const auto trunk = simulation::calibrateTrunkRadii(opt);
+      printSamples("trunk", trunk);
+      append("trunk_calibration", trunk.calibration);
     }
-    const auto& c = result.calibration;
-    std::string yaml = "  # calibrate_diameters --radii-mm " + radii_mm + " --noise-mm " +
-                       noise_mm + "\n  trunk_calibration_radii: " + yamlList(c.radii) +
-                       "\n  trunk_calibration_noise: " + yamlList(c.noise) +
-                       "\n  trunk_calibration_bias: " + yamlList(c.bias) + "\n";
+    if (only != "trunk") {
+      opt.radii = parseList(branch_radii_mm, 1e-3);
+      const auto branch = simulation::calibrateBranchRadii(opt);
+      printSamples("branch", branch);
+      append("branch_calibration", branch.calibration);
+    }
     std::cout << yaml;
     if (!output.empty())
       io::writeTextFile(output, yaml);

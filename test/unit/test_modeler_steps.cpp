@@ -242,6 +242,10 @@ TEST(ModelerConfig, ShippedConfigLoads) {
   EXPECT_EQ(c.trunk_calibration.radii, d.radii);
   EXPECT_EQ(c.trunk_calibration.noise, d.noise);
   EXPECT_EQ(c.trunk_calibration.bias, d.bias);
+  const RadiusCalibration b = defaultBranchCalibration();
+  EXPECT_EQ(c.branch_calibration.radii, b.radii);
+  EXPECT_EQ(c.branch_calibration.noise, b.noise);
+  EXPECT_EQ(c.branch_calibration.bias, b.bias);
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/radius_calibration.h"
-#include "dormant_tree_modeling/simulation/trunk_calibration.h"
+#include "dormant_tree_modeling/simulation/branch_calibration.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -109,6 +109,28 @@ TEST(TrunkCalibration, ThinPolesLookWiderThanThickOnes) {
   EXPECT_LT(std::abs(result.calibration.bias[1]), 0.004);
   o.radii = {0.05, 0.01};
   EXPECT_THROW(simulation::calibrateTrunkRadii(o), Error);
+}
+
+TEST(BranchCalibration, ThinRodsLookWiderAndTheTableIsMonotone) {
+  // The reference tree through a reduced plan: every rod is found; a thin rod's apparent
+  // (RMS) radius carries the footprint and noise, so exceeds its true radius by more than a
+  // thick rod's does, and the apparent radius still grows with the true one (invertible).
+  simulation::TrunkCalibrationOptions o;
+  o.radii = {0.004, 0.015};
+  o.noise = {0.006};
+  o.plan.heights = {1.5};
+  o.plan.slide_steps = 2;
+  const auto result = simulation::calibrateBranchRadii(o);
+  ASSERT_EQ(result.samples.size(), 2u);
+  const auto& thin = result.samples[0];
+  const auto& thick = result.samples[1];
+  EXPECT_GT(thin.apparent - thin.radius, thick.apparent - thick.radius);
+  EXPECT_GT(thin.apparent, thin.radius);
+  EXPECT_GT(thick.apparent, thin.apparent);
+  EXPECT_GT(thin.noise_estimate, 0.0);
+  const auto& c = result.calibration;
+  ASSERT_TRUE(c.valid());
+  EXPECT_NEAR(c.correct(thick.apparent, thick.noise_estimate, 0.002), 0.015, 1e-6);
 }
 
 }  // namespace

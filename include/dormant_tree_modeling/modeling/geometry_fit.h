@@ -111,7 +111,8 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 /// least-squares cylinder on them when it agrees with the line (within 20 deg, radius within
 /// bounds), and the radius from the scatter-corrected second moment sqrt(mean d^2 - scatter^2).
 /// @param sigma range noise: sets the bands (m)
-/// @param scatter total scatter removed from the moment (noise and beam spread; 0: none) (m)
+/// @param scatter total scatter removed from the moment (noise and beam spread); 0: the raw
+///        RMS distance from the axis, which may exceed max_radius by the scatter (m)
 /// @param inliers set to the indices of the points used for the radius
 std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
                                         double sigma, double scatter, double max_radius,

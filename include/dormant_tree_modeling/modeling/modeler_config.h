@@ -11,6 +11,9 @@ namespace modeling {
 /// @brief The trunk radius calibration shipped in config/tree_modeler.yaml.
 RadiusCalibration defaultTrunkCalibration();
 
+/// @brief The branch radius calibration shipped in config/tree_modeler.yaml.
+RadiusCalibration defaultBranchCalibration();
+
 /// @brief Every parameter of the tree modeler. Defaults are the paper's values (Medeiros et
 /// al., docs/algorithms.md) where the paper tuned one; the `ours_*` switches turn on what we
 /// add past the paper, each separately so its effect can be measured. Lengths in m, angles in
@@ -60,6 +63,14 @@ struct ModelerConfig {
   /// no correction. Default: made by `calibrate_diameters` on the LMS111 model with the
   /// paper's 40-view plan (config/tree_modeler.yaml); re-make it from field references.
   RadiusCalibration trunk_calibration = defaultTrunkCalibration();
+  /// Branch radius calibration: the apparent radius is the RMS distance of a branch's points
+  /// from its axis (footprint and noise dominate it on thin branches); the table maps it to
+  /// the true radius. YAML keys branch_calibration_radii, _noise, _bias (m); empty lists: the
+  /// moment less beam_spread and noise in quadrature instead. Made by `calibrate_diameters`.
+  RadiusCalibration branch_calibration = defaultBranchCalibration();
+  /// Diagnostic: report branches' raw RMS radius, uncorrected (what calibrate_diameters
+  /// measures to build branch_calibration).
+  bool branch_raw_radius = false;
 
   double trunk_max_tilt = 30.0;  ///< trunk cylinders' axes within this of vertical
   double radius_continuity =

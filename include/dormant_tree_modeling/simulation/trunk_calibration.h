@@ -7,6 +7,7 @@
 #include "dormant_tree_modeling/acquisition/view_plan.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/simulation/lms111_model.h"
+#include "dormant_tree_modeling/simulation/scene.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {
@@ -40,6 +41,20 @@ struct TrunkCalibrationResult {
   modeling::RadiusCalibration calibration;
   std::vector<CalibrationSample> samples;
 };
+
+/// @brief Every view of the plan through `scene` with range noise `noise`, merged into the
+/// scene frame and cropped to `crop_radius` around the vertical axis through the origin.
+std::vector<Eigen::Vector3d> scanReferenceScene(const Scene& scene, double noise,
+                                                const TrunkCalibrationOptions& options,
+                                                std::uint64_t seed, double crop_radius);
+
+/// @brief @throws Error INVALID_ARGUMENT unless radii and noise are positive and ascending.
+void checkCalibrationAxes(const TrunkCalibrationOptions& options);
+
+/// @brief Append one noise level's row to a table: `bias[k]` where `measured[k]`, elsewhere
+/// the nearest measured radius's bias; the noise axis value is kept ascending.
+void appendCalibrationRow(modeling::RadiusCalibration& table, std::vector<double> bias,
+                          const std::vector<char>& measured, double noise_axis);
 
 /// @brief Scan two poles per noise level (radii ascending and descending, so that each radius
 /// is seen both low and high) and tabulate apparent minus true radius. The table's noise axis
