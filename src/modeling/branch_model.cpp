@@ -74,6 +74,9 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
   double threshold = config.cylinder_threshold;
   if (config.ours_derive_parameters)
     threshold = std::max(threshold, 2.5 * sigma);
+  double base_z = 1e300;
+  for (const auto& c : trunk.cylinders)
+    base_z = std::min(base_z, (c.center - 0.5 * c.length * c.axis).z());
   const double s_lo = trunk.cylinder_ranges.front().first - 0.05;
   const double s_hi = trunk.cylinder_ranges.back().second + 0.05;
 
@@ -182,6 +185,14 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         continue;
       const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
       if (nearest_gap > SURFACE_CONTACT + reach)
+        continue;
+    }
+    if (config.ours_constrain_ransac) {
+      // Primaries are at least 0.2 m long and start above the ground: a short fragment is a
+      // spur, a shoot or what an extraction left of a branch; near the ground it is mixed
+      // pixels between the trunk base and the soil.
+      if (cyl->length < config.branch_min_length ||
+          attachment.z() - base_z < config.branch_min_height)
         continue;
     }
     Points in;

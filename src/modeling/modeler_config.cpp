@@ -82,6 +82,8 @@ const std::map<std::string, Setter>& setters() {
       {"branch_max_radial_angle", setter(&C::branch_max_radial_angle)},
       {"branch_axis_gap", setter(&C::branch_axis_gap)},
       {"branch_inner_gap", setter(&C::branch_inner_gap)},
+      {"branch_min_length", setter(&C::branch_min_length)},
+      {"branch_min_height", setter(&C::branch_min_height)},
       {"floating_radius", setter(&C::floating_radius)},
       {"floating_min_neighbors", setter(&C::floating_min_neighbors)},
       {"wire_min_length", setter(&C::wire_min_length)},
@@ -168,6 +170,8 @@ void ModelerConfig::validate() const {
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
   check("branch_axis_gap", branch_axis_gap, 0.0, 1.0);
   check("branch_inner_gap", branch_inner_gap, 0.0, 1.0);
+  check("branch_min_length", branch_min_length, 0.0, 2.0);
+  check("branch_min_height", branch_min_height, 0.0, 5.0);
 
   check("floating_radius", floating_radius, 0.001, 0.5);
   check("floating_min_neighbors", floating_min_neighbors, 1, 1000);
