@@ -14,8 +14,7 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
-constexpr int MAX_EXTRACTIONS = 400;  // re-clustered remainders per tree, a bound on the work  //
-                                      // m: a branch's nearest points lie this close to the trunk
+constexpr int MAX_EXTRACTIONS = 400;  // re-clustered remainders per tree, a bound on the work
 
 /// Where a point sits relative to the trunk model.
 struct TrunkCoords {
@@ -64,7 +63,8 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
 }  // namespace
 
 std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
-                                     const std::vector<int>& region, const ModelerConfig& config) {
+                                     const std::vector<int>& region, const ModelerConfig& config,
+                                     std::vector<RejectedBranch>* rejected) {
   std::vector<BranchFit> branches;
   if (trunk.cylinders.empty())
     return branches;
@@ -139,15 +139,48 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         sub_index.push_back(candidates[k]);
       }
     }
-    if (static_cast<int>(sub.size()) < config.branch_min_points)
+    // A candidate that fits no branch may be several branches fused into one cluster (close
+    // neighbours, a shoot bridging two): split in two by position and look at each half.
+    auto reject = [&](const char* reason, bool splittable) {
+      if (splittable && config.ours_constrain_ransac && extractions < MAX_EXTRACTIONS &&
+          static_cast<int>(cluster.size()) >= 4 * config.branch_min_points) {
+        Points cluster_pts;
+        for (const int k : cluster)
+          cluster_pts.push_back(cand_pts[k]);
+        const auto labels = kMeans(cluster_pts, 2, 20, config.seed * 7757ULL + stream++);
+        std::vector<int> halves[2];
+        for (std::size_t k = 0; k < cluster.size(); ++k)
+          halves[labels[k]].push_back(cluster[k]);
+        if (!halves[0].empty() && !halves[1].empty()) {
+          work.push_back(std::move(halves[0]));
+          work.push_back(std::move(halves[1]));
+          extractions += 2;
+          return;
+        }
+      }
+      if (!rejected)
+        return;
+      RejectedBranch r;
+      for (const int k : cluster)
+        r.centroid += cand_pts[k];
+      r.centroid /= static_cast<double>(cluster.size());
+      r.points = static_cast<int>(cluster.size());
+      r.reason = reason;
+      rejected->push_back(r);
+    };
+    if (static_cast<int>(sub.size()) < config.branch_min_points) {
+      reject("too few points", false);
       continue;
+    }
     const Cylinder& seg = trunk.cylinders[segment];
     Eigen::Vector3d centroid;
     Eigen::Vector3d axis = principalAxis(sub, &centroid);
     Eigen::Vector3d radial =
         (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
-    if (radial.norm() < 1e-9)
+    if (radial.norm() < 1e-9) {
+      reject("no fit", true);
       continue;
+    }
     radial.normalize();
     if (axis.dot(radial) < 0.0)
       axis = -axis;
@@ -172,28 +205,41 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
                                             : ransacCylinder(sub, axis, o, &inliers);
     if (cyl && calibrated && !config.branch_raw_radius && config.ours_constrain_ransac)
       cyl->radius = config.branch_calibration.correct(cyl->radius, sigma, MIN_BRANCH_RADIUS);
-    if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points)
+    if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points) {
+      reject("no fit", true);
       continue;
+    }
     if (cyl->axis.dot(radial) < 0.0)
       cyl->axis = -cyl->axis;
     Eigen::Vector3d attachment;
     const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
     if (config.ours_constrain_ransac) {
-      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle)
+      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle) {
+        reject("not radial", true);
         continue;
-      if (gap > seg.radius + config.branch_axis_gap)
+      }
+      if (gap > seg.radius + config.branch_axis_gap) {
+        reject("misses the trunk", true);
         continue;
+      }
       const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
-      if (nearest_gap > SURFACE_CONTACT + reach)
+      if (nearest_gap > SURFACE_CONTACT + reach) {
+        reject("not at the surface", true);
         continue;
+      }
     }
     if (config.ours_constrain_ransac) {
       // Primaries are at least 0.2 m long and start above the ground: a short fragment is a
       // spur, a shoot or what an extraction left of a branch; near the ground it is mixed
       // pixels between the trunk base and the soil.
-      if (cyl->length < config.branch_min_length ||
-          attachment.z() - base_z < config.branch_min_height)
+      if (cyl->length < config.branch_min_length) {
+        reject("too short", false);
         continue;
+      }
+      if (attachment.z() - base_z < config.branch_min_height) {
+        reject("too low", false);
+        continue;
+      }
     }
     Points in;
     BranchFit fit;
@@ -241,7 +287,16 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         const double angle = std::acos(
             std::clamp(branches[i].cylinder.axis.dot(branches[k].cylinder.axis), -1.0, 1.0));
         if ((branches[i].attachment - branches[k].attachment).norm() < 0.06 && angle < 25.0 * DEG) {
-          drop[branches[i].inliers.size() >= branches[k].inliers.size() ? k : i] = 1;
+          const std::size_t loser =
+              branches[i].inliers.size() >= branches[k].inliers.size() ? k : i;
+          drop[loser] = 1;
+          if (rejected) {
+            RejectedBranch r;
+            r.centroid = branches[loser].cylinder.center;
+            r.points = static_cast<int>(branches[loser].inliers.size());
+            r.reason = "duplicate";
+            rejected->push_back(r);
+          }
         }
       }
     }

@@ -225,7 +225,7 @@ ModelResult TreeModeler::model(const Points& input) const {
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
-  const auto branches = modelBranches(pts, trunk, region, config_);
+  const auto branches = modelBranches(pts, trunk, region, config_, &result.rejected_branches);
   watch.lap("branches");
 
   // Model, measurements and point classes.

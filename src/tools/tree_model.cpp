@@ -1,6 +1,7 @@
 // tree_model: the tree modeler on a cloud file. Exit codes are documented in the README.
 #include <boost/program_options.hpp>
 #include <iostream>
+#include <map>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
@@ -84,6 +85,13 @@ int main(int argc, char** argv) {
                 << " trunk, " << result.primary_clusters << " primary)\n";
       for (const auto& t : result.timings)
         std::cerr << "  " << t.first << ": " << t.second << " s\n";
+      std::map<std::string, int> reasons;
+      for (const auto& r : result.rejected_branches)
+        ++reasons[r.reason];
+      std::cerr << "  branch candidates turned down:";
+      for (const auto& [reason, n] : reasons)
+        std::cerr << " " << reason << " " << n << ";";
+      std::cerr << "\n";
     }
     std::cout << "tree_model: " << result.model.trunk.size() << " trunk cylinders, "
               << result.model.primary_branches.size() << " primary branches in "

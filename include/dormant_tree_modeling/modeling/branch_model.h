@@ -1,5 +1,6 @@
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
@@ -17,6 +18,14 @@ struct BranchFit {
   Eigen::Vector3d attachment = Eigen::Vector3d::Zero();  ///< on the trunk axis
 };
 
+/// @brief A branch candidate that was turned down, and why (for diagnostics).
+struct RejectedBranch {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the candidate's points
+  int points = 0;
+  std::string reason;  ///< "too few points", "no fit", "not radial", "misses the trunk",
+                       ///< "not at the surface", "too short", "too low", "duplicate"
+};
+
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
 /// config.ours_branch_shell, every point of the cloud in a shell around the trunk cylinders.
@@ -25,8 +34,10 @@ struct BranchFit {
 /// With config.ours_constrain_ransac a branch must leave the trunk surface: its axis points
 /// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
 /// crossing near the trunk do not), and duplicates of one branch are merged.
+/// @param rejected when given, receives every candidate turned down
 std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
-                                     const std::vector<int>& region, const ModelerConfig& config);
+                                     const std::vector<int>& region, const ModelerConfig& config,
+                                     std::vector<RejectedBranch>* rejected = nullptr);
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

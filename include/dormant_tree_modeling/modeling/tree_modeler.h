@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dormant_tree_modeling/common/cloud.h"
+#include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/preprocess.h"
@@ -28,6 +29,7 @@ struct ModelResult {
   int trunk_clusters = 0;
   int primary_clusters = 0;
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
+  std::vector<RejectedBranch> rejected_branches;        ///< candidates turned down, and why
 };
 
 /// @brief Algorithms 2 and 3 of the paper (docs/algorithms.md), plus the switchable additions of
