@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "dormant_tree_modeling/modeling/point_index.h"
 
@@ -60,6 +61,31 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
   return (x - y).norm();
 }
 
+/// A thin horizontal line that continues straight through the trunk and out of its other
+/// side is a trellis wire (a branch ends at the trunk); preprocessing misses wires that run
+/// shorter than wire_min_length inside a tight crop.
+bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const PointIndex& index,
+                   double sigma) {
+  constexpr double MAX_WIRE_RADIUS = 0.004;
+  constexpr double MAX_WIRE_TILT = 15.0 * DEG;
+  constexpr double STEP = 0.02;
+  if (c.radius > MAX_WIRE_RADIUS || std::abs(c.axis.z()) > std::sin(MAX_WIRE_TILT))
+    return false;
+  // Walk the axis backwards through the trunk: sample the far side from 5 to 40 cm past the
+  // trunk surface.
+  Eigen::Vector3d through;
+  lineGap(c.center, c.axis, trunk_segment.center, trunk_segment.axis, &through);
+  const double t_trunk = (through - c.center).dot(c.axis);
+  const double tolerance = 0.008 + sigma;
+  int samples = 0, occupied = 0;
+  for (double d = trunk_segment.radius + 0.05; d <= trunk_segment.radius + 0.4; d += STEP) {
+    const Eigen::Vector3d q = c.center + (t_trunk - d) * c.axis;
+    ++samples;
+    occupied += index.countWithin(q, tolerance, 1) > 0;
+  }
+  return samples > 0 && occupied >= 0.8 * samples;
+}
+
 }  // namespace
 
 std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
@@ -106,6 +132,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     for (const int i : region)
       consider(i);
   }
+  std::unique_ptr<PointIndex> full_index;
+  auto cloud_index = [&]() -> const PointIndex& {
+    if (!full_index)
+      full_index = std::make_unique<PointIndex>(pts);
+    return *full_index;
+  };
   Points cand_pts;
   for (const int i : candidates)
     cand_pts.push_back(pts[i]);
@@ -240,6 +272,10 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         reject("too low", false);
         continue;
       }
+    }
+    if (config.ours_remove_clutter && looksLikeWire(*cyl, seg, cloud_index(), sigma)) {
+      reject("a wire", false);
+      continue;
     }
     Points in;
     BranchFit fit;
