@@ -287,6 +287,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
       cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_BRANCH_RADIUS);
     }
     fit.cylinder = *cyl;
+    fit.candidates = sub.size();
     fit.trunk_segment = segment;
     fit.attachment = attachment;
     branches.push_back(std::move(fit));

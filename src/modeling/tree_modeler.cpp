@@ -254,8 +254,8 @@ ModelResult TreeModeler::model(const Points& input) const {
   for (std::size_t b = 0; b < branches.size(); ++b) {
     const BranchFit& f = branches[b];
     PrimaryBranch pb;
-    pb.cylinder = toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(),
-                          f.inliers.size());
+    pb.cylinder =
+        toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(), f.candidates);
     pb.trunk_segment = f.trunk_segment;
     const Cylinder& seg = trunk.cylinders[f.trunk_segment];
     pb.measurement.attachment_height = f.attachment.z() - base_z;

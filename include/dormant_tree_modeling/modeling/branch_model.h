@@ -12,9 +12,10 @@ namespace modeling {
 
 /// @brief One primary branch found on the trunk.
 struct BranchFit {
-  Cylinder cylinder;                                     ///< axis points away from the trunk
-  int trunk_segment = 0;                                 ///< index into TrunkModel::cylinders
-  std::vector<int> inliers;                              ///< indices into the modeled cloud
+  Cylinder cylinder;           ///< axis points away from the trunk
+  int trunk_segment = 0;       ///< index into TrunkModel::cylinders
+  std::vector<int> inliers;    ///< indices into the modeled cloud
+  std::size_t candidates = 0;  ///< points of its candidate cluster within the fit length
   Eigen::Vector3d attachment = Eigen::Vector3d::Zero();  ///< on the trunk axis
 };
 
