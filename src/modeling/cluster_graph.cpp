@@ -1,4 +1,5 @@
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/common/parallel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -70,8 +71,7 @@ std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& con
   std::vector<Cluster> clusters(count);
   for (std::size_t i = 0; i < labels.size(); ++i)
     clusters[labels[i]].members.push_back(static_cast<int>(i));
-  for (auto& c : clusters)
-    updateCluster(pts, c);
+  parallelFor(count, [&](int c) { updateCluster(pts, clusters[c]); });
   return clusters;
 }
 
@@ -149,10 +149,10 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
       auto& m = next[slot[r]].members;
       m.insert(m.end(), clusters[i].members.begin(), clusters[i].members.end());
     }
-    for (auto& c : next) {
-      std::sort(c.members.begin(), c.members.end());
-      updateCluster(pts, c);
-    }
+    parallelFor(static_cast<int>(next.size()), [&](int c) {
+      std::sort(next[c].members.begin(), next[c].members.end());
+      updateCluster(pts, next[c]);
+    });
     clusters.swap(next);
   }
   return clusters;
@@ -165,16 +165,16 @@ std::vector<std::vector<int>> connectClusters(const Points& pts,
   std::vector<int> owner(pts.size(), -1);
   std::vector<Eigen::Vector3d> lo(n), hi(n);
   std::vector<std::unique_ptr<PointIndex>> index(n);
-  for (int c = 0; c < n; ++c) {
+  parallelFor(n, [&](int c) {
     lo[c] = Eigen::Vector3d::Constant(1e300);
     hi[c] = -lo[c];
     for (const int i : clusters[c].members) {
-      owner[i] = c;
+      owner[i] = c;  // members of different clusters are disjoint
       lo[c] = lo[c].cwiseMin(pts[i]);
       hi[c] = hi[c].cwiseMax(pts[i]);
     }
     index[c] = std::make_unique<PointIndex>(gather(pts, clusters[c].members));
-  }
+  });
   const PointIndex all(pts);
   // The point of `from` nearest to cluster `to`, and the share of its N neighbours in `to`.
   auto share = [&](int from, int to) {
@@ -200,8 +200,9 @@ std::vector<std::vector<int>> connectClusters(const Points& pts,
       inside += owner[j] == to;
     return static_cast<double>(inside) / static_cast<double>(nn.size());
   };
-  std::vector<std::vector<int>> adjacency(n);
-  for (int i = 0; i < n; ++i) {
+  // Each pair's test is independent: rows on all cores, assembled in the sequential order.
+  std::vector<std::vector<int>> linked(n);
+  parallelFor(n, [&](int i) {
     for (int k = i + 1; k < n; ++k) {
       if (((lo[i].array() > hi[k].array() + LINK_MARGIN) ||
            (lo[k].array() > hi[i].array() + LINK_MARGIN))
@@ -214,6 +215,12 @@ std::vector<std::vector<int>> connectClusters(const Points& pts,
       const double b = share(k, i);
       if (b < config.n_low || b > config.n_high)
         continue;
+      linked[i].push_back(k);
+    }
+  });
+  std::vector<std::vector<int>> adjacency(n);
+  for (int i = 0; i < n; ++i) {
+    for (const int k : linked[i]) {
       adjacency[i].push_back(k);
       adjacency[k].push_back(i);
     }

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "dormant_tree_modeling/common/parallel.h"
@@ -41,20 +42,53 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
   std::vector<Eigen::Vector3d> sums(k);
   std::vector<int> counts(k);
   std::vector<char> moved(n, 0);
+  // Hamerly's exact acceleration of Lloyd's assignment: per point an upper bound on the
+  // distance to its centre and a lower bound on the distance to any other; a point whose
+  // bounds prove its centre nearest is not scanned. Same labels as the plain scan.
+  std::vector<double> upper(n, std::numeric_limits<double>::infinity()), lower(n, 0.0);
+  std::vector<double> half_gap(k, 0.0), shift(k, 0.0);
+  auto scan = [&](int i) {
+    int best = 0;
+    double best_d = std::numeric_limits<double>::infinity(),
+           second = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < k; ++c) {
+      const double d = (pts[i] - centres[c]).squaredNorm();
+      if (d < best_d) {
+        second = best_d;
+        best_d = d;
+        best = c;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    moved[i] = labels[i] != best;
+    labels[i] = best;
+    upper[i] = std::sqrt(best_d);
+    lower[i] = std::sqrt(second);
+  };
   for (int it = 0; it < max_iterations; ++it) {
+    for (int c = 0; c < k; ++c) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int o = 0; o < k; ++o) {
+        if (o != c)
+          nearest = std::min(nearest, (centres[c] - centres[o]).norm());
+      }
+      half_gap[c] = 0.5 * nearest;
+    }
     // Assignment: independent per point, so it runs on every core with identical results.
     parallelFor(n, [&](int i) {
-      int best = 0;
-      double best_d = std::numeric_limits<double>::infinity();
-      for (int c = 0; c < k; ++c) {
-        const double d = (pts[i] - centres[c]).squaredNorm();
-        if (d < best_d) {
-          best_d = d;
-          best = c;
-        }
+      moved[i] = 0;
+      if (it == 0) {
+        scan(i);
+        return;
       }
-      moved[i] = labels[i] != best;
-      labels[i] = best;
+      const double bound = std::max(half_gap[labels[i]], lower[i]);
+      if (upper[i] <= bound)
+        return;
+      upper[i] = (pts[i] - centres[labels[i]]).norm();
+      if (upper[i] <= bound)
+        return;
+      scan(i);
     });
     const bool changed = std::find(moved.begin(), moved.end(), 1) != moved.end();
     std::fill(sums.begin(), sums.end(), Eigen::Vector3d::Zero());
@@ -63,12 +97,22 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
       sums[labels[i]] += pts[i];
       ++counts[labels[i]];
     }
+    double max_shift = 0.0;
     for (int c = 0; c < k; ++c) {
-      if (counts[c] > 0)
-        centres[c] = sums[c] / counts[c];
+      shift[c] = 0.0;
+      if (counts[c] > 0) {
+        const Eigen::Vector3d next = sums[c] / counts[c];
+        shift[c] = (next - centres[c]).norm();
+        centres[c] = next;
+      }
+      max_shift = std::max(max_shift, shift[c]);
     }
     if (!changed && it > 0)
       break;
+    for (int i = 0; i < n; ++i) {
+      upper[i] += shift[labels[i]];
+      lower[i] -= max_shift;
+    }
   }
   // Renumber so that every label in [0, k') is used (an emptied centre leaves a gap).
   std::vector<int> remap(k, -1);

@@ -1,6 +1,7 @@
 #include "dormant_tree_modeling/modeling/preprocess.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -206,20 +207,31 @@ double medianSpacing(const Points& pts) {
 Points voxelDownsample(const Points& pts, double voxel) {
   if (voxel <= 0.0)
     return pts;
-  std::map<std::tuple<long, long, long>, std::pair<Eigen::Vector3d, int>> cells;
-  for (const auto& p : pts) {
-    const auto key = std::make_tuple(static_cast<long>(std::floor(p.x() / voxel)),
-                                     static_cast<long>(std::floor(p.y() / voxel)),
-                                     static_cast<long>(std::floor(p.z() / voxel)));
-    // Eigen leaves a default-constructed vector uninitialised: start each cell explicitly.
-    auto it = cells.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
-    it->second.first += p;
-    ++it->second.second;
+  // Sort the points by voxel (x, then y, then z), stably, and average each run: the same
+  // cells, order and sums as a map of voxels, without a tree node per voxel.
+  using Key = std::array<long, 3>;
+  std::vector<std::pair<Key, int>> keyed(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto& p = pts[i];
+    keyed[i] = {Key{static_cast<long>(std::floor(p.x() / voxel)),
+                    static_cast<long>(std::floor(p.y() / voxel)),
+                    static_cast<long>(std::floor(p.z() / voxel))},
+                static_cast<int>(i)};
   }
+  std::stable_sort(keyed.begin(), keyed.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
   Points out;
-  out.reserve(cells.size());
-  for (const auto& kv : cells)
-    out.push_back(kv.second.first / kv.second.second);
+  for (std::size_t i = 0; i < keyed.size();) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    std::size_t j = i;
+    for (; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {
+      sum += pts[keyed[j].second];
+      ++count;
+    }
+    out.push_back(sum / count);
+    i = j;
+  }
   return out;
 }
 
