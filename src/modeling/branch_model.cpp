@@ -246,7 +246,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     Eigen::Vector3d attachment;
     const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
     if (config.ours_constrain_ransac) {
-      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle) {
+      // Seen along the trunk a primary points away from it, whatever its elevation; a fit
+      // across two branches, or a branch and a shoot, points sideways.
+      const Eigen::Vector3d across = cyl->axis - cyl->axis.dot(seg.axis) * seg.axis;
+      const bool sideways =
+          across.norm() > 0.3 && std::acos(std::clamp(across.normalized().dot(radial), -1.0, 1.0)) >
+                                     config.branch_max_azimuth * DEG;
+      if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle || sideways) {
         reject("not radial", true);
         continue;
       }

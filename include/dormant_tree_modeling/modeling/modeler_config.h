@@ -76,7 +76,9 @@ struct ModelerConfig {
   double radius_continuity =
       0.35;  ///< a trunk segment's radius within this share of its neighbour's
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
-  double branch_axis_gap = 0.10;          ///< branch axis must pass this close to the trunk surface
+  /// Branch axis seen along the trunk (elevation removed) vs the direction away from it, deg.
+  double branch_max_azimuth = 20.0;
+  double branch_axis_gap = 0.10;    ///< branch axis must pass this close to the trunk surface
   double branch_min_length = 0.12;  ///< shorter detections are fragments (primaries: >= 0.2 m)
   double branch_min_height = 0.3;   ///< no primary attaches lower above the trunk base (m)
   double branch_inner_gap =
