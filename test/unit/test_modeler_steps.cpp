@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
@@ -181,6 +183,34 @@ TEST(TrunkModel, TaperedTrunkWithBranchesGivesSegmentsAndRadii) {
       share_clear = std::min(share_clear, s.outlier_share);
   }
   EXPECT_GT(share_at_branch, share_clear + 0.05);
+}
+
+TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);  // trunk
+  const std::size_t trunk_points = pts.size();
+  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);     // a primary
+  addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.008, 0.14);     // a 14 cm stub
+  addCylinder(pts, {0, 0.03, 0.15}, {0, 1, 0}, 0.01, 0.4);        // at the soil
+  addCylinder(pts, {0.032, -0.6, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // a wire passing the trunk
+  addCylinder(pts, {0.032, 0.05, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // and on past it
+  std::vector<int> region(trunk_points);
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.002;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  std::vector<RejectedBranch> rejected;
+  const auto branches = modelBranches(pts, trunk, region, config, &rejected);
+  ASSERT_EQ(branches.size(), 1u);
+  const Cylinder& b = branches[0].cylinder;
+  EXPECT_GT(b.axis.dot(Eigen::Vector3d(1, 0.1, 0.2).normalized()), std::cos(5.0 * M_PI / 180));
+  EXPECT_NEAR(branches[0].attachment.z(), 0.8, 0.03);
+  std::map<std::string, int> reasons;
+  for (const auto& r : rejected)
+    ++reasons[r.reason];
+  EXPECT_EQ(reasons["a wire"], 2);
+  EXPECT_EQ(reasons["too short"], 1);
+  EXPECT_EQ(reasons["too low"], 1);
 }
 
 TEST(TrunkModel, TooLittleIsNoTrunk) {
