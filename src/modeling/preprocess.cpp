@@ -237,8 +237,35 @@ Points voxelDownsample(const Points& pts, double voxel) {
 
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
   std::vector<char> mask(pts.size(), 0);
+  // Any two points in a cube whose diagonal is under the radius are neighbours: a point
+  // sharing such a cell with min_neighbors others is settled without a search (most points
+  // of a dense scan); only the others go to the k-d tree. Same answer, a fraction of the work.
+  const double cell = 0.95 * radius / std::sqrt(3.0);
+  using Key = std::array<long, 3>;
+  std::vector<std::pair<Key, int>> keyed(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    keyed[i] = {Key{static_cast<long>(std::floor(pts[i].x() / cell)),
+                    static_cast<long>(std::floor(pts[i].y() / cell)),
+                    static_cast<long>(std::floor(pts[i].z() / cell))},
+                static_cast<int>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<int> open;
+  for (std::size_t i = 0; i < keyed.size();) {
+    std::size_t j = i;
+    while (j < keyed.size() && keyed[j].first == keyed[i].first)
+      ++j;
+    if (static_cast<int>(j - i) <= min_neighbors) {
+      for (std::size_t k = i; k < j; ++k)
+        open.push_back(keyed[k].second);
+    }
+    i = j;
+  }
+  if (open.empty())
+    return mask;
   const PointIndex index(pts);
-  parallelFor(static_cast<int>(pts.size()), [&](int i) {
+  parallelFor(static_cast<int>(open.size()), [&](int k) {
+    const int i = open[k];
     mask[i] = index.countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
   });
   return mask;

@@ -221,6 +221,7 @@ ModelResult TreeModeler::model(const Points& input) const {
       }
     }
   }
+  watch.lap("track");
   const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
 
   result.noise_sigma = trunk.noise_sigma;

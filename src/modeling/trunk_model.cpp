@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -60,14 +61,15 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
       members[n].push_back(region[k]);
   }
   std::vector<Slice> slices(count);
-  for (int n = 0; n < count; ++n) {
+  // Slices are independent (each RANSAC seeded by its index): all cores, same result.
+  parallelFor(count, [&](int n) {
     Slice& sl = slices[n];
     sl.s0 = lo + n * height;
     sl.points = static_cast<int>(members[n].size());
     if (sl.points < MIN_SLICE_POINTS) {
       sl.outliers = sl.points;
       sl.outlier_share = sl.points > 0 ? 1.0 : 0.0;
-      continue;
+      return;
     }
     const double mid = sl.s0 + 0.5 * height;
     const Eigen::Vector3d origin = line.pointAt(mid), dir = line.directionAt(mid);
@@ -129,7 +131,7 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
         }
       }
     }
-  }
+  });
   return slices;
 }
 
