@@ -22,6 +22,7 @@ namespace {
 
 constexpr std::size_t MIN_POINTS = 100;
 constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
+constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
 
 class Stopwatch {
  public:
@@ -100,7 +101,7 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
       continue;
     // And down to the ground: where the first cluster begins is an accident of k-means.
     const TrackedTrunk down = trackTrunk(pts, index, tracked.centers.front(), -up,
-                                         tracked.radii.front(), threshold, config, 2);
+                                         tracked.radii.front(), threshold, config);
     tracked.centers.insert(tracked.centers.begin(), down.centers.rbegin(), down.centers.rend());
     tracked.radii.insert(tracked.radii.begin(), down.radii.rbegin(), down.radii.rend());
     double shell = 0.0;
@@ -110,7 +111,14 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
                index.countWithin(tracked.centers[k], r + 0.05, 1 << 20);
     }
     const double off_centre = (start.head<2>() - middle).norm() / CENTRE_PRIOR_SCALE;
-    const double score = shell * std::exp(-off_centre * off_centre);
+    // A trunk stands on the ground: a track whose lowest slice floats above the cloud's
+    // bottom is a branch or the leader's top half, whatever the branches around it.
+    double lowest = 1e300;
+    for (const auto& c : tracked.centers)
+      lowest = std::min(lowest, c.z());
+    const double floating = std::max(0.0, lowest - (zmin + GROUND_REACH)) / GROUND_REACH;
+    const double score =
+        shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
     if (score > best_score) {
       best_score = score;
       best = std::move(tracked);

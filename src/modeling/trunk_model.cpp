@@ -19,6 +19,7 @@ constexpr double ZERO_SLOPE = 0.05;  // |d eta_share| below this is a flat eta
 constexpr int MIN_SLICE_POINTS = 12;
 constexpr double MIN_TRUNK_RADIUS = 0.003;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
+constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
 
 struct Projected {
   std::vector<double> s;  // arc length of each region point
@@ -305,7 +306,10 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
   std::uint64_t stream = 0;
   for (int step = 0; step < 400 && misses < max_misses; ++step) {
     const Eigen::Vector3d predicted = c + h * t;
-    const double lateral = std::max(3.0 * r, r + 0.05);
+    // Until the first circle is found the start's radius is only a guess (a cluster's fit
+    // to an arc of a thick trunk can be half its size): search wide, any trunk radius.
+    const bool first = out.centers.empty();
+    const double lateral = first ? std::max(FIRST_WINDOW, 3.0 * r) : std::max(3.0 * r, r + 0.05);
     const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
     Points2 plane;
     for (const int i : index.within(predicted, std::hypot(0.5 * h, lateral))) {
@@ -316,8 +320,8 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     CircleRansacOptions o;
     o.threshold = threshold;
     o.iterations = config.ransac_iterations;
-    o.min_radius = std::max(MIN_TRUNK_RADIUS, 0.6 * r);
-    o.max_radius = 1.25 * r;
+    o.min_radius = first ? MIN_TRUNK_RADIUS : std::max(MIN_TRUNK_RADIUS, 0.6 * r);
+    o.max_radius = first ? std::max(1.25 * r, 0.5 * FIRST_WINDOW) : 1.25 * r;
     o.seed = config.seed * 31337 + stream++;
     std::vector<int> inliers;
     std::optional<Circle> circle;
@@ -353,8 +357,8 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
       }
     }
 
-    const bool ok =
-        circle && inliers.size() >= MIN_SLICE_POINTS / 2 && circle->center.norm() < r + 0.02;
+    const bool ok = circle && inliers.size() >= MIN_SLICE_POINTS / 2 &&
+                    circle->center.norm() < (first ? lateral : r + 0.02);
     if (!ok) {
       ++misses;
       c = predicted;
