@@ -293,6 +293,31 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
   return cyl;
 }
 
+/// A segment from its slices alone: axis the centreline's chord over [a, b], radius the median
+/// of the slices' corrected radii there; nothing when fewer than two slices have a circle.
+std::optional<Cylinder> segmentFromSlices(const std::vector<Slice>& slices, const Centerline& line,
+                                          double a, double b, double slice_height) {
+  std::vector<double> r;
+  for (const auto& sl : slices) {
+    const double mid = sl.s0 + 0.5 * slice_height;
+    if (sl.has_circle && mid >= a && mid < b)
+      r.push_back(sl.corrected_radius);
+  }
+  if (r.size() < 2)
+    return std::nullopt;
+  Cylinder c;
+  const Eigen::Vector3d p0 = line.pointAt(a), p1 = line.pointAt(b);
+  c.axis = (p1 - p0).normalized();
+  if (!c.axis.allFinite())
+    return std::nullopt;
+  if (c.axis.z() < 0.0)
+    c.axis = -c.axis;
+  c.center = 0.5 * (p0 + p1);
+  c.length = (p1 - p0).norm();
+  c.radius = std::max(MIN_TRUNK_RADIUS, median(r));
+  return c;
+}
+
 }  // namespace
 
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
@@ -540,6 +565,14 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                               scatter, config, 1000 + i)) {
       trunk.cylinders.push_back(*cyl);
       trunk.cylinder_ranges.emplace_back(a, b);
+    } else if (config.ours_follow_diameter) {
+      // The slices measured this stretch even where one RANSAC cylinder does not fit it (a
+      // whorl of branches, a bend): the centreline's chord and the slices' median radius,
+      // rather than a gap in the trunk that would orphan the branches on it.
+      if (auto chord = segmentFromSlices(slices, line, a, b, config.slice_height)) {
+        trunk.cylinders.push_back(*chord);
+        trunk.cylinder_ranges.emplace_back(a, b);
+      }
     }
   }
   if (trunk.cylinders.empty())
