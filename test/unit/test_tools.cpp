@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "dormant_tree_modeling/evaluation/ground_truth.h"
@@ -127,6 +128,32 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
   EXPECT_EQ(trunk.rfind("trunk,0,-1,100.000000", 0), 0u) << trunk;
   EXPECT_NE(branch.find(",90.00,"), std::string::npos) << branch;
   EXPECT_NE(branch.find(",0.400,0"), std::string::npos) << branch;
+}
+
+TEST(Lms111DecodeTool, DecodesTheRealTelegramAndRejectsOthers) {
+  test::TempDir dir;
+  std::string out;
+  const std::string real = std::string(DTM_SHARED_DATA_DIR) + "/lms1xx/lms1xx_scan_541pts.txt";
+  ASSERT_EQ(run("lms111_decode", real, &out), 0) << out;
+  EXPECT_NE(out.find("\"name\": \"DIST1\""), std::string::npos);
+  EXPECT_NE(out.find("\"count\": 541"), std::string::npos);
+  EXPECT_NE(out.find("\"start_angle_deg\": -45.0"), std::string::npos);
+  EXPECT_NE(out.find("\"serial_number\": \"A037B9\""), std::string::npos);
+  // With STX/ETX and garbage around it, the same telegram.
+  {
+    std::ifstream in(real);
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    std::ofstream(dir.file("framed.bin"))
+        << "xx\x02" << text.substr(0, text.find_last_not_of("\r\n") + 1) << "\x03yy";
+  }
+  std::string framed;
+  EXPECT_EQ(run("lms111_decode", dir.file("framed.bin"), &framed), 0) << framed;
+  EXPECT_EQ(framed, out);
+  EXPECT_EQ(run("lms111_decode", "", &out), 2);
+  EXPECT_EQ(run("lms111_decode", dir.file("absent.txt"), &out), 3);
+  std::ofstream(dir.file("other.txt")) << "sRA STlms 7";
+  EXPECT_EQ(run("lms111_decode", dir.file("other.txt"), &out), 4);
+  EXPECT_NE(out.find("not a scan telegram"), std::string::npos) << out;
 }
 
 }  // namespace
