@@ -256,6 +256,18 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         reject("not radial", true);
         continue;
       }
+      // Primaries leave the trunk between about 20 deg below and 45 deg above the horizontal,
+      // and no thicker than the trunk there: a fit that dives or is wider than the trunk took
+      // in something else (a shoot hanging from the branch, a neighbour).
+      if (std::acos(std::clamp(cyl->axis.dot(seg.axis), -1.0, 1.0)) >
+          (90.0 - config.branch_min_elevation) * DEG) {
+        reject("points down", true);
+        continue;
+      }
+      if (cyl->radius > config.branch_max_diameter_ratio * seg.radius) {
+        reject("thicker than the trunk", true);
+        continue;
+      }
       if (gap > seg.radius + config.branch_axis_gap) {
         reject("misses the trunk", true);
         continue;

@@ -81,6 +81,8 @@ const std::map<std::string, Setter>& setters() {
       {"radius_continuity", setter(&C::radius_continuity)},
       {"branch_max_radial_angle", setter(&C::branch_max_radial_angle)},
       {"branch_max_azimuth", setter(&C::branch_max_azimuth)},
+      {"branch_min_elevation", setter(&C::branch_min_elevation)},
+      {"branch_max_diameter_ratio", setter(&C::branch_max_diameter_ratio)},
       {"branch_axis_gap", setter(&C::branch_axis_gap)},
       {"branch_inner_gap", setter(&C::branch_inner_gap)},
       {"branch_min_length", setter(&C::branch_min_length)},
@@ -170,6 +172,8 @@ void ModelerConfig::validate() const {
   check("radius_continuity", radius_continuity, 0.01, 10.0);
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
   check("branch_max_azimuth", branch_max_azimuth, 1.0, 180.0);
+  check("branch_min_elevation", branch_min_elevation, -90.0, 90.0);
+  check("branch_max_diameter_ratio", branch_max_diameter_ratio, 0.1, 10.0);
   check("branch_axis_gap", branch_axis_gap, 0.0, 1.0);
   check("branch_inner_gap", branch_inner_gap, 0.0, 1.0);
   check("branch_min_length", branch_min_length, 0.0, 2.0);

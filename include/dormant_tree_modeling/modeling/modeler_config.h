@@ -78,6 +78,8 @@ struct ModelerConfig {
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
   /// Branch axis seen along the trunk (elevation removed) vs the direction away from it, deg.
   double branch_max_azimuth = 20.0;
+  double branch_min_elevation = -30.0;  ///< deg above the trunk's normal plane (primaries: >= -20)
+  double branch_max_diameter_ratio = 1.0;  ///< a primary is not thicker than the trunk there
   double branch_axis_gap = 0.10;    ///< branch axis must pass this close to the trunk surface
   double branch_min_length = 0.12;  ///< shorter detections are fragments (primaries: >= 0.2 m)
   double branch_min_height = 0.3;   ///< no primary attaches lower above the trunk base (m)
