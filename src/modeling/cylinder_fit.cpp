@@ -3,6 +3,7 @@
 #include <map>
 
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 namespace dormant_tree_modeling {
@@ -190,13 +191,10 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
 double noiseFromRadialResiduals(std::vector<double> residuals) {
   if (residuals.empty())
     return 0.0;
-  const std::size_t mid = residuals.size() / 2;
-  std::nth_element(residuals.begin(), residuals.begin() + mid, residuals.end());
-  const double median = residuals[mid];
+  const double centre = median(residuals);
   for (double& r : residuals)
-    r = std::abs(r - median);
-  std::nth_element(residuals.begin(), residuals.begin() + mid, residuals.end());
-  return 1.4826 * residuals[mid] * std::sqrt(1.5);
+    r = std::abs(r - centre);
+  return 1.4826 * median(std::move(residuals)) * std::sqrt(1.5);
 }
 
 double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
@@ -348,10 +346,8 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     if (total_n < 6)
       return std::nullopt;
     double moment = total / total_n;
-    if (!moments.empty()) {
-      std::nth_element(moments.begin(), moments.begin() + moments.size() / 2, moments.end());
-      moment = moments[moments.size() / 2];
-    }
+    if (!moments.empty())
+      moment = median(std::move(moments));
     // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
     // it may exceed the radius bound by the scatter it carries.
     const double upper =

@@ -8,6 +8,7 @@
 
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -198,10 +199,7 @@ double medianSpacing(const Points& pts) {
     if (nn.size() == 2)
       d.push_back((pts[nn[1]] - pts[i]).norm());
   }
-  if (d.empty())
-    return 0.0;
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
+  return median(std::move(d));
 }
 
 Points voxelDownsample(const Points& pts, double voxel) {

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
@@ -213,9 +214,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   if (config_.ours_follow_diameter) {
     if (const auto tracked = trackBestTrunk(pts, clusters, path, config_)) {
       axis = tracked->centers;
-      std::vector<double> r = tracked->radii;
-      std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-      radius = r[r.size() / 2];
+      radius = median(tracked->radii);
       // The trunk region becomes every point near the tracked axis, not only the clusters
       // Algorithm 2 linked.
       const Centerline line(axis);

@@ -7,6 +7,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -24,14 +25,6 @@ constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for 
 struct Projected {
   std::vector<double> s;  // arc length of each region point
 };
-
-double median(std::vector<double> v) {
-  if (v.empty())
-    return 0.0;
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
 
 /// RANSAC circles of every slice along the centreline.
 /// Radius range a slice circle may take and how far from the centreline its points may lie.

@@ -8,6 +8,7 @@
 
 #include "dormant_tree_modeling/acquisition/range_image.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
@@ -19,13 +20,6 @@ namespace {
 
 constexpr double BAND_MARGIN = 0.05;  // m at each band end left out: the radius steps there
 constexpr double CROP_RADIUS = 0.3;   // m around the pole's axis
-
-double median(std::vector<double> v) {
-  if (v.empty())
-    return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 /// A vertical pole at the tree's place whose radius steps through `radii`, one band each.
 Scene poleScene(const std::vector<double>& radii, const TrunkCalibrationOptions& o) {
