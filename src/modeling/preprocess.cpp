@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
-#include <tuple>
 
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
@@ -186,6 +184,22 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   return removed;
 }
 
+using CellKey = std::array<long, 3>;
+
+/// Every point's grid cell (edge `cell`) with its index, sorted by cell and then by index:
+/// each cell's points form one run, in input order.
+std::vector<std::pair<CellKey, int>> sortedByCell(const Points& pts, double cell) {
+  std::vector<std::pair<CellKey, int>> keyed(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    keyed[i] = {CellKey{static_cast<long>(std::floor(pts[i].x() / cell)),
+                        static_cast<long>(std::floor(pts[i].y() / cell)),
+                        static_cast<long>(std::floor(pts[i].z() / cell))},
+                static_cast<int>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  return keyed;
+}
+
 }  // namespace
 
 double medianSpacing(const Points& pts) {
@@ -207,17 +221,7 @@ Points voxelDownsample(const Points& pts, double voxel) {
     return pts;
   // Sort the points by voxel (x, then y, then z), stably, and average each run: the same
   // cells, order and sums as a map of voxels, without a tree node per voxel.
-  using Key = std::array<long, 3>;
-  std::vector<std::pair<Key, int>> keyed(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const auto& p = pts[i];
-    keyed[i] = {Key{static_cast<long>(std::floor(p.x() / voxel)),
-                    static_cast<long>(std::floor(p.y() / voxel)),
-                    static_cast<long>(std::floor(p.z() / voxel))},
-                static_cast<int>(i)};
-  }
-  std::stable_sort(keyed.begin(), keyed.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  const auto keyed = sortedByCell(pts, voxel);
   Points out;
   for (std::size_t i = 0; i < keyed.size();) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -239,15 +243,7 @@ std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbo
   // sharing such a cell with min_neighbors others is settled without a search (most points
   // of a dense scan); only the others go to the k-d tree. Same answer, a fraction of the work.
   const double cell = 0.95 * radius / std::sqrt(3.0);
-  using Key = std::array<long, 3>;
-  std::vector<std::pair<Key, int>> keyed(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    keyed[i] = {Key{static_cast<long>(std::floor(pts[i].x() / cell)),
-                    static_cast<long>(std::floor(pts[i].y() / cell)),
-                    static_cast<long>(std::floor(pts[i].z() / cell))},
-                static_cast<int>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end());
+  const auto keyed = sortedByCell(pts, cell);
   std::vector<int> open;
   for (std::size_t i = 0; i < keyed.size();) {
     std::size_t j = i;
