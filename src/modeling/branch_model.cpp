@@ -100,9 +100,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
   double threshold = config.cylinder_threshold;
   if (config.ours_derive_parameters)
     threshold = std::max(threshold, 2.5 * sigma);
-  double base_z = 1e300;
-  for (const auto& c : trunk.cylinders)
-    base_z = std::min(base_z, (c.center - 0.5 * c.length * c.axis).z());
+  const double base_z = trunk.baseZ();
   const double s_lo = trunk.cylinder_ranges.front().first - 0.05;
   const double s_hi = trunk.cylinder_ranges.back().second + 0.05;
 

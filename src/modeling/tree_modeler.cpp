@@ -240,10 +240,9 @@ ModelResult TreeModeler::model(const Points& input) const {
   TreeModel& model = result.model;
   model.input_points = input.size();
   result.classes.assign(pts.size(), PointClass::OTHER);
-  double base_z = 1e300;
+  const double base_z = trunk.baseZ();
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
     const Cylinder& c = trunk.cylinders[i];
-    base_z = std::min(base_z, (c.center - 0.5 * c.length * c.axis).z());
     std::size_t inliers = 0, total = 0;
     for (const int k : region) {
       const double s = trunk.centerline.project(pts[k]);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
@@ -312,6 +313,13 @@ std::optional<Cylinder> segmentFromSlices(const std::vector<Slice>& slices, cons
 }
 
 }  // namespace
+
+double TrunkModel::baseZ() const {
+  double z = std::numeric_limits<double>::infinity();
+  for (const auto& c : cylinders)
+    z = std::min(z, (c.center - 0.5 * c.length * c.axis).z());
+  return z;
+}
 
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,

@@ -56,6 +56,10 @@ struct TrunkModel {
   /// Total scatter removed from radii: sqrt(noise_sigma^2 + beam_spread^2) when the bias
   /// correction is on, else 0 (m).
   double scatter = 0.0;
+
+  /// @brief Height of the trunk's base: the lowest end of its cylinders (m); heights on the
+  /// tree (attachment heights, the lowest primary) count from here.
+  double baseZ() const;
 };
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
