@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
@@ -27,7 +28,6 @@ struct Projected {
   std::vector<double> s;  // arc length of each region point
 };
 
-/// RANSAC circles of every slice along the centreline.
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
   double min_radius = MIN_TRUNK_RADIUS;
@@ -35,12 +35,14 @@ struct SliceBounds {
   double max_distance = 1e300;
 };
 
+/// RANSAC circles of every slice along the centreline. With calibrate_at (the range noise), each
+/// slice's corrected radius goes through the trunk calibration; without, it is the radius.
 std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
                                  const Centerline& line, const std::vector<double>& s,
                                  const std::vector<double>& dist, double height, double threshold,
                                  const SliceBounds& bounds,
                                  const std::vector<double>* expected_radius, double continuity,
-                                 double sigma, const ModelerConfig& config) {
+                                 std::optional<double> calibrate_at, const ModelerConfig& config) {
   double lo = 1e300, hi = -1e300;
   for (const double v : s) {
     lo = std::min(lo, v);
@@ -120,9 +122,9 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
           sl.radius = surface->radius;
           sl.center = origin + surface->center.x() * u + surface->center.y() * v;
           // The beam footprint's wings widen thin sections: the calibration takes them off.
-          sl.corrected_radius =
-              sigma > 0.0 ? config.trunk_calibration.correct(sl.radius, sigma, MIN_TRUNK_RADIUS)
-                          : sl.radius;
+          sl.corrected_radius = calibrate_at ? config.trunk_calibration.correct(
+                                                   sl.radius, *calibrate_at, MIN_TRUNK_RADIUS)
+                                             : sl.radius;
         }
       }
     }
@@ -471,12 +473,12 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   // Pass 1: slices on the initial axis, to refine the centreline and estimate the noise.
   auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds,
-                              nullptr, 0.0, 0.0, config);
+                              nullptr, 0.0, std::nullopt, config);
   for (int round = 0; round < 2; ++round) {
     line = refineCenterline(slices, line, std::max(initial_radius, 0.02), h);
     projectAll();
     slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr,
-                           0.0, 0.0, config);
+                           0.0, std::nullopt, config);
   }
 
   Points region_pts;
@@ -501,7 +503,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     const auto expected = expectedRadii(slices);
     slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
                            config.ours_constrain_ransac ? &expected : nullptr,
-                           config.radius_continuity, std::max(sigma, 1e-6), config);
+                           config.radius_continuity, sigma, config);
   }
   trunk.slices = slices;
   trunk.centerline = line;
