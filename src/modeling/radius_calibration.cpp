@@ -19,19 +19,19 @@ std::pair<std::size_t, double> locate(const std::vector<double>& grid, double x)
   return {i, (x - grid[i]) / (grid[i + 1] - grid[i])};
 }
 
-bool ascending(const std::vector<double>& v) {
-  for (std::size_t i = 1; i < v.size(); ++i) {
-    if (!(v[i] > v[i - 1]))
+}  // namespace
+
+bool strictlyAscending(const std::vector<double>& values) {
+  for (std::size_t i = 1; i < values.size(); ++i) {
+    if (!(values[i] > values[i - 1]))
       return false;
   }
   return true;
 }
 
-}  // namespace
-
 bool RadiusCalibration::valid() const {
   return !radii.empty() && !noise.empty() && bias.size() == radii.size() * noise.size() &&
-         ascending(radii) && ascending(noise);
+         strictlyAscending(radii) && strictlyAscending(noise);
 }
 
 double RadiusCalibration::biasAt(double radius, double sigma) const {

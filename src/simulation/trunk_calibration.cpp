@@ -66,16 +66,10 @@ std::vector<Eigen::Vector3d> scanReferenceScene(const Scene& scene, double noise
 }
 
 void checkCalibrationAxes(const TrunkCalibrationOptions& o) {
-  auto ascending = [](const std::vector<double>& v) {
-    if (v.empty() || !(v.front() > 0.0))
-      return false;
-    for (std::size_t i = 1; i < v.size(); ++i) {
-      if (!(v[i] > v[i - 1]))
-        return false;
-    }
-    return true;
+  auto usable = [](const std::vector<double>& v) {
+    return !v.empty() && v.front() > 0.0 && modeling::strictlyAscending(v);
   };
-  if (!ascending(o.radii) || !ascending(o.noise))
+  if (!usable(o.radii) || !usable(o.noise))
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "calibration radii and noise levels must be positive and ascending");
 }

@@ -5,6 +5,9 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
+/// @brief Whether every value is larger than the one before (true for fewer than two).
+bool strictlyAscending(const std::vector<double>& values);
+
 /// @brief Systematic radius error of the trunk's slice estimate, apparent minus true, as a
 /// table over the true radius and the range noise the modeler estimates. A laser beam that
 /// partly hits a thin object reports its range along the beam centre, so each silhouette edge
