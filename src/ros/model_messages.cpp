@@ -27,15 +27,22 @@ dormant_tree_modeling::Cylinder cylinderMsg(const modeling::CylinderModel& c, st
   return m;
 }
 
-visualization_msgs::Marker cylinderMarker(const modeling::CylinderModel& c,
-                                          const std_msgs::Header& header, const std::string& ns,
-                                          float r, float g, float b) {
+/// A marker to add, of a type, keyed by namespace and id.
+visualization_msgs::Marker newMarker(const std_msgs::Header& header, const std::string& ns, int id,
+                                     int type) {
   visualization_msgs::Marker m;
   m.header = header;
   m.ns = ns;
-  m.id = c.id;
-  m.type = visualization_msgs::Marker::CYLINDER;
+  m.id = id;
+  m.type = type;
   m.action = visualization_msgs::Marker::ADD;
+  return m;
+}
+
+visualization_msgs::Marker cylinderMarker(const modeling::CylinderModel& c,
+                                          const std_msgs::Header& header, const std::string& ns,
+                                          float r, float g, float b) {
+  visualization_msgs::Marker m = newMarker(header, ns, c.id, visualization_msgs::Marker::CYLINDER);
   m.pose.position.x = c.center.x();
   m.pose.position.y = c.center.y();
   m.pose.position.z = c.center.z();
@@ -56,12 +63,8 @@ visualization_msgs::Marker cylinderMarker(const modeling::CylinderModel& c,
 
 visualization_msgs::Marker label(const modeling::CylinderModel& c, const std_msgs::Header& header,
                                  const std::string& ns) {
-  visualization_msgs::Marker m;
-  m.header = header;
-  m.ns = ns;
-  m.id = c.id;
-  m.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
-  m.action = visualization_msgs::Marker::ADD;
+  visualization_msgs::Marker m =
+      newMarker(header, ns, c.id, visualization_msgs::Marker::TEXT_VIEW_FACING);
   const Eigen::Vector3d p = c.center + 0.5 * c.length * c.axis;
   m.pose.position.x = p.x();
   m.pose.position.y = p.y();
