@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/simulation/branch_calibration.h"
@@ -73,12 +74,8 @@ int main(int argc, char** argv) {
       "threads", po::value(&opt.threads)->default_value(0), "worker threads, 0 = all cores");
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (tools::parseOrHelp(argc, argv, desc, vm))
       return 0;
-    }
-    po::notify(vm);
     if (!only.empty() && only != "trunk" && only != "branch")
       throw po::error("--only takes trunk or branch");
     opt.noise = parseList(noise_mm, 1e-3);

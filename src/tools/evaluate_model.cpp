@@ -2,6 +2,7 @@
 #include <boost/program_options.hpp>
 #include <iostream>
 
+#include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
 #include "dormant_tree_modeling/io/tree_json.h"
@@ -24,12 +25,8 @@ int main(int argc, char** argv) {
       "cylinder with its errors");
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (tools::parseOrHelp(argc, argv, desc, vm))
       return 0;
-    }
-    po::notify(vm);
     if (models.empty() || models.size() != truths.size()) {
       std::cerr << "evaluate_model: give as many --model as --truth (at least one pair)\n";
       return 2;

@@ -2,6 +2,7 @@
 #include <boost/program_options.hpp>
 #include <iostream>
 
+#include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 
@@ -32,12 +33,8 @@ int main(int argc, char** argv) {
       "threads", po::value(&opt.threads)->default_value(0), "worker threads, 0 = all cores");
   try {
     po::variables_map vm;
-    po::store(po::parse_command_line(argc, argv, desc), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (tools::parseOrHelp(argc, argv, desc, vm))
       return 0;
-    }
-    po::notify(vm);
     opt.sensor.range_noise_sigma = noise_mm / 1000.0;
     opt.sensor.angular_resolution_deg = resolution;
     opt.sensor.scan_frequency_hz = resolution == 0.5 ? 50.0 : 25.0;

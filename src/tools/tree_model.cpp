@@ -3,6 +3,7 @@
 #include <iostream>
 #include <map>
 
+#include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
@@ -53,12 +54,8 @@ int main(int argc, char** argv) {
   positional.add("input", 1);
   try {
     po::variables_map vm;
-    po::store(po::command_line_parser(argc, argv).options(desc).positional(positional).run(), vm);
-    if (vm.count("help")) {
-      std::cout << desc << "\n";
+    if (tools::parseOrHelp(argc, argv, desc, vm, positional))
       return 0;
-    }
-    po::notify(vm);
     if (input.empty() || output.empty()) {
       std::cerr << "tree_model: INPUT and --output are required\n" << desc << "\n";
       return 2;
