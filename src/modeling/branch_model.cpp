@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <memory>
 
 #include "dormant_tree_modeling/modeling/point_index.h"
 
@@ -88,8 +87,9 @@ bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const Point
 
 }  // namespace
 
-std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
-                                     const std::vector<int>& region, const ModelerConfig& config,
+std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
+                                     const TrunkModel& trunk, const std::vector<int>& region,
+                                     const ModelerConfig& config,
                                      std::vector<RejectedBranch>* rejected) {
   std::vector<BranchFit> branches;
   if (trunk.cylinders.empty())
@@ -130,12 +130,6 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
     for (const int i : region)
       consider(i);
   }
-  std::unique_ptr<PointIndex> full_index;
-  auto cloud_index = [&]() -> const PointIndex& {
-    if (!full_index)
-      full_index = std::make_unique<PointIndex>(pts);
-    return *full_index;
-  };
   Points cand_pts;
   for (const int i : candidates)
     cand_pts.push_back(pts[i]);
@@ -289,7 +283,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
         continue;
       }
     }
-    if (config.ours_remove_clutter && looksLikeWire(*cyl, seg, cloud_index(), sigma)) {
+    if (config.ours_remove_clutter && looksLikeWire(*cyl, seg, index, sigma)) {
       reject("a wire", false);
       continue;
     }

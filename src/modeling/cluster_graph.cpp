@@ -158,7 +158,7 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
   return clusters;
 }
 
-std::vector<std::vector<int>> connectClusters(const Points& pts,
+std::vector<std::vector<int>> connectClusters(const Points& pts, const PointIndex& all,
                                               const std::vector<Cluster>& clusters,
                                               const ModelerConfig& config) {
   const int n = static_cast<int>(clusters.size());
@@ -175,7 +175,6 @@ std::vector<std::vector<int>> connectClusters(const Points& pts,
     }
     index[c] = std::make_unique<PointIndex>(gather(pts, clusters[c].members));
   });
-  const PointIndex all(pts);
   // The point of `from` nearest to cluster `to`, and the share of its N neighbours in `to`.
   auto share = [&](int from, int to) {
     double best = std::numeric_limits<double>::infinity();

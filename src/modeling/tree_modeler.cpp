@@ -63,7 +63,8 @@ double noiseGuess(const Points& pts, const Cluster& cluster) {
 /// piece near the bottom, Algorithm 2's start among them) and keep the track with the most
 /// points around it between 5 and 35 cm from its axis: branches. A post has none, a
 /// neighbour's branch is no vertical cylinder.
-std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<Cluster>& clusters,
+std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
+                                           const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config) {
   double zmin = std::numeric_limits<double>::infinity();
   for (const auto& c : clusters)
@@ -86,7 +87,6 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const std::vector<
     hi = hi.cwiseMax(p.head<2>());
   }
   const Eigen::Vector2d middle = 0.5 * (lo + hi);
-  const PointIndex index(pts);
   std::optional<TrackedTrunk> best;
   double best_score = -1.0;
   for (const int c : candidates) {
@@ -180,7 +180,9 @@ ModelResult TreeModeler::model(const Points& input) const {
   clusters = splitClusters(pts, std::move(clusters), result.split_error, config_);
   clusters = mergeClusters(pts, std::move(clusters), config_.merge_distance);
   watch.lap("split_merge");
-  const auto adjacency = connectClusters(pts, clusters, config_);
+  // One index of the modeled cloud for the graph, the trunk tracking and the branch step.
+  const PointIndex index(pts);
+  const auto adjacency = connectClusters(pts, index, clusters, config_);
   const TrunkPath path = findTrunkPath(clusters, adjacency, config_);
   watch.lap("graph");
   result.clusters = static_cast<int>(clusters.size());
@@ -212,7 +214,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   std::sort(radii.begin(), radii.end());
   double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
   if (config_.ours_follow_diameter) {
-    if (const auto tracked = trackBestTrunk(pts, clusters, path, config_)) {
+    if (const auto tracked = trackBestTrunk(pts, index, clusters, path, config_)) {
       axis = tracked->centers;
       radius = median(tracked->radii);
       // The trunk region becomes every point near the tracked axis, not only the clusters
@@ -233,7 +235,8 @@ ModelResult TreeModeler::model(const Points& input) const {
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
-  const auto branches = modelBranches(pts, trunk, region, config_, &result.rejected_branches);
+  const auto branches =
+      modelBranches(pts, index, trunk, region, config_, &result.rejected_branches);
   watch.lap("branches");
 
   // Model, measurements and point classes.

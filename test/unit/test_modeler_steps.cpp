@@ -99,7 +99,7 @@ struct Fixture {
 TEST(ClusterGraph, InterfaceTestConnectsTouchingPiecesOnly) {
   const Fixture f;
   ModelerConfig config;
-  const auto adjacency = connectClusters(f.pts, f.clusters, config);
+  const auto adjacency = connectClusters(f.pts, PointIndex(f.pts), f.clusters, config);
   auto connected = [&](int a, int b) {
     return std::find(adjacency[a].begin(), adjacency[a].end(), b) != adjacency[a].end();
   };
@@ -118,7 +118,7 @@ TEST(ClusterGraph, TrunkPathClimbsAndBranchesAreAdjacent) {
   const Fixture f;
   for (const bool ours : {false, true}) {
     ModelerConfig config = ours ? ModelerConfig{} : ModelerConfig::paper();
-    const auto adjacency = connectClusters(f.pts, f.clusters, config);
+    const auto adjacency = connectClusters(f.pts, PointIndex(f.pts), f.clusters, config);
     const TrunkPath path = findTrunkPath(f.clusters, adjacency, config);
     EXPECT_EQ(path.trunk, (std::vector<int>{0, 1, 2})) << (ours ? "ours" : "paper");
     EXPECT_EQ(path.primary, (std::vector<int>{3})) << (ours ? "ours" : "paper");
@@ -129,7 +129,7 @@ TEST(ClusterGraph, PsiTStopsAtNearHorizontalSteps) {
   const Fixture f;
   ModelerConfig config = ModelerConfig::paper();
   config.psi_t = 1.0;  // only perfectly vertical steps
-  const auto adjacency = connectClusters(f.pts, f.clusters, config);
+  const auto adjacency = connectClusters(f.pts, PointIndex(f.pts), f.clusters, config);
   EXPECT_EQ(findTrunkPath(f.clusters, adjacency, config).trunk.size(),
             3u);  // the stack is exactly vertical
   std::vector<Cluster> tilted = f.clusters;
@@ -200,7 +200,7 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   config.noise_sigma = 0.002;
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
   std::vector<RejectedBranch> rejected;
-  const auto branches = modelBranches(pts, trunk, region, config, &rejected);
+  const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config, &rejected);
   ASSERT_EQ(branches.size(), 1u);
   const Cylinder& b = branches[0].cylinder;
   EXPECT_GT(b.axis.dot(Eigen::Vector3d(1, 0.1, 0.2).normalized()), std::cos(5.0 * M_PI / 180));

@@ -5,6 +5,7 @@
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
 namespace dormant_tree_modeling {
@@ -35,9 +36,11 @@ struct RejectedBranch {
 /// With config.ours_constrain_ransac a branch must leave the trunk surface: its axis points
 /// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
 /// crossing near the trunk do not), and duplicates of one branch are merged.
+/// @param index a PointIndex of `pts`
 /// @param rejected when given, receives every candidate turned down
-std::vector<BranchFit> modelBranches(const Points& pts, const TrunkModel& trunk,
-                                     const std::vector<int>& region, const ModelerConfig& config,
+std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
+                                     const TrunkModel& trunk, const std::vector<int>& region,
+                                     const ModelerConfig& config,
                                      std::vector<RejectedBranch>* rejected = nullptr);
 
 }  // namespace modeling

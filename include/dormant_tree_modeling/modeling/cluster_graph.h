@@ -5,6 +5,7 @@
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -42,7 +43,8 @@ std::vector<Cluster> mergeClusters(const Points& pts, std::vector<Cluster> clust
 /// @brief Step 4: adjacency lists of the bidirectional interface test: P_i and P_k are
 /// connected when, from both sides, the point p nearest to the other cluster has between n_L
 /// and n_H of its N nearest neighbours (in the whole cloud) in the other cluster.
-std::vector<std::vector<int>> connectClusters(const Points& pts,
+/// @param index a PointIndex of `pts` (the whole cloud)
+std::vector<std::vector<int>> connectClusters(const Points& pts, const PointIndex& index,
                                               const std::vector<Cluster>& clusters,
                                               const ModelerConfig& config);
 
