@@ -17,6 +17,20 @@ bool isHexDigit(char c) {
 
 }  // namespace
 
+const char* protocolName(Protocol protocol) {
+  return protocol == Protocol::COLA_A ? "CoLa-A" : "CoLa-B";
+}
+
+std::string frame(Protocol protocol, const std::string& payload) {
+  return protocol == Protocol::COLA_A ? frameColaA(payload) : frameColaB(payload);
+}
+
+std::unique_ptr<Framer> makeFramer(Protocol protocol, std::size_t max_payload) {
+  if (protocol == Protocol::COLA_A)
+    return std::make_unique<ColaAFramer>(max_payload);
+  return std::make_unique<ColaBFramer>(max_payload);
+}
+
 std::string frameColaA(const std::string& text) {
   return std::string(1, STX) + text + std::string(1, ETX);
 }
@@ -145,79 +159,6 @@ std::optional<std::int64_t> parseColaNumber(const std::string& t) {
     v = (v << 4) | static_cast<std::uint64_t>(c <= '9' ? c - '0' : (c | 0x20) - 'a' + 10);
   }
   return static_cast<std::int64_t>(v);
-}
-
-void ColaAReader::fail(const char* field, const std::string& what) const {
-  throw Error(ErrorCode::PARSE_ERROR, std::string("telegram field '") + field + "' at character " +
-                                          std::to_string(pos_) + ": " + what);
-}
-
-std::string ColaAReader::token(const char* field) {
-  if (pos_ < text_.size() && pos_ > 0) {
-    if (text_[pos_] != ' ')
-      fail(field, "expected a space");
-    ++pos_;
-  }
-  if (pos_ >= text_.size())
-    fail(field, "the telegram ends early");
-  const std::size_t end = text_.find(' ', pos_);
-  const std::size_t stop = end == std::string::npos ? text_.size() : end;
-  if (stop == pos_)
-    fail(field, "empty field (two spaces)");
-  std::string t = text_.substr(pos_, stop - pos_);
-  pos_ = stop;
-  return t;
-}
-
-std::uint64_t ColaAReader::unsignedValue(const char* field, int bits) {
-  const std::string t = token(field);
-  const auto v = parseColaNumber(t);
-  if (!v || *v < 0)
-    fail(field, "'" + t + "' is not an unsigned number");
-  if (bits < 64 && static_cast<std::uint64_t>(*v) >> bits)
-    fail(field, "'" + t + "' exceeds " + std::to_string(bits) + " bits");
-  return static_cast<std::uint64_t>(*v);
-}
-
-std::int32_t ColaAReader::signedValue(const char* field) {
-  const std::string t = token(field);
-  const auto v = parseColaNumber(t);
-  if (!v)
-    fail(field, "'" + t + "' is not a number");
-  if (t[0] == '+' || t[0] == '-') {
-    if (*v < INT32_MIN || *v > INT32_MAX)
-      fail(field, "'" + t + "' exceeds 32 bits");
-    return static_cast<std::int32_t>(*v);
-  }
-  if (static_cast<std::uint64_t>(*v) >> 32)
-    fail(field, "'" + t + "' exceeds 32 bits");
-  return static_cast<std::int32_t>(static_cast<std::uint32_t>(*v));
-}
-
-float ColaAReader::floatValue(const char* field) {
-  const std::string t = token(field);
-  const auto v = parseColaNumber(t);
-  if (!v || t[0] == '+' || t[0] == '-' || static_cast<std::uint64_t>(*v) >> 32)
-    fail(field, "'" + t + "' is not a hex IEEE-754 float");
-  const auto bits = static_cast<std::uint32_t>(*v);
-  float f;
-  std::memcpy(&f, &bits, sizeof f);
-  return f;
-}
-
-std::string ColaAReader::characters(const char* field, std::size_t length) {
-  if (pos_ >= text_.size() || text_[pos_] != ' ')
-    fail(field, "expected a space before the string");
-  ++pos_;
-  if (pos_ + length > text_.size())
-    fail(field, "string of " + std::to_string(length) + " characters runs past the end");
-  std::string s = text_.substr(pos_, length);
-  pos_ += length;
-  return s;
-}
-
-bool ColaAReader::atEnd() const {
-  return pos_ >= text_.size() || text_.find_first_not_of(' ', pos_) == std::string::npos;
 }
 
 std::string describeSfaError(int code) {

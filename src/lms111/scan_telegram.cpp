@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/lms111/cola.h"
+#include "dormant_tree_modeling/lms111/cola_fields.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {
@@ -13,10 +13,12 @@ namespace lms111 {
 namespace {
 
 constexpr std::size_t MAX_CHANNELS = 16;
-constexpr std::size_t MAX_VALUES = 10000;  // a channel of the LMS1xx holds at most 1081
+constexpr std::size_t MAX_VALUES = 10000;      // a channel of the LMS1xx holds at most 1081
+constexpr std::size_t CHANNEL_NAME_WIDTH = 5;  // DIST1, RSSI1, ...: fixed width in CoLa-B
+constexpr std::size_t EVENT_TYPE_WIDTH = 4;
 
-bool readFlag(ColaAReader& r, const char* field) {
-  const auto v = r.unsignedValue(field, 8);
+bool readFlag(FieldReader& r, const char* field) {
+  const auto v = r.unsignedValue(field, 16);
   if (v > 1) {
     throw Error(ErrorCode::PARSE_ERROR, std::string("telegram field '") + field +
                                             "': flag must be 0 or 1, is " + std::to_string(v));
@@ -24,7 +26,7 @@ bool readFlag(ColaAReader& r, const char* field) {
   return v == 1;
 }
 
-std::vector<ScanChannel> readChannels(ColaAReader& r, bool sixteen_bit) {
+std::vector<ScanChannel> readChannels(FieldReader& r, bool sixteen_bit) {
   const auto count =
       r.unsignedValue(sixteen_bit ? "number of 16-bit channels" : "number of 8-bit channels", 16);
   if (count > MAX_CHANNELS) {
@@ -34,7 +36,7 @@ std::vector<ScanChannel> readChannels(ColaAReader& r, bool sixteen_bit) {
   }
   std::vector<ScanChannel> channels(count);
   for (auto& c : channels) {
-    c.name = r.token("channel name");
+    c.name = r.label("channel name", CHANNEL_NAME_WIDTH);
     c.scale = r.floatValue("scale factor");
     c.offset = r.floatValue("scale offset");
     c.start_angle = r.signedValue("start angle");
@@ -65,18 +67,6 @@ std::string hex(std::uint64_t v) {
   return buf;
 }
 
-std::string hexFloat(float f) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &f, sizeof bits);
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "%08X", bits);
-  return buf;
-}
-
-std::string hexSigned(std::int32_t v) {
-  return hex(static_cast<std::uint32_t>(v));
-}
-
 }  // namespace
 
 const ScanChannel* ScanTelegram::channel(const std::string& name) const {
@@ -87,15 +77,16 @@ const ScanChannel* ScanTelegram::channel(const std::string& name) const {
   return nullptr;
 }
 
-ScanTelegram parseScanTelegram(const std::string& text) {
-  ColaAReader r(text);
+ScanTelegram parseScanTelegram(const std::string& payload, Protocol protocol) {
+  const auto reader = makeReader(protocol, payload);
+  FieldReader& r = *reader;
   ScanTelegram s;
-  s.command_type = r.token("command type");
+  s.command_type = r.word("command type");
   if (s.command_type != "sSN" && s.command_type != "sRA") {
     throw Error(ErrorCode::PARSE_ERROR,
                 "not a scan telegram: command type '" + s.command_type + "' (sSN or sRA)");
   }
-  const std::string name = r.token("command");
+  const std::string name = r.word("command");
   if (name != "LMDscandata")
     throw Error(ErrorCode::PARSE_ERROR, "not a scan telegram: command '" + name + "'");
   s.version = static_cast<std::uint16_t>(r.unsignedValue("version", 16));
@@ -108,9 +99,9 @@ ScanTelegram parseScanTelegram(const std::string& text) {
   s.time_since_startup_us = static_cast<std::uint32_t>(r.unsignedValue("time since start-up"));
   s.time_of_transmission_us = static_cast<std::uint32_t>(r.unsignedValue("time of transmission"));
   for (auto& v : s.digital_inputs)
-    v = static_cast<std::uint16_t>(r.unsignedValue("digital inputs", 16));
+    v = static_cast<std::uint16_t>(r.unsignedValue("digital inputs", 8));
   for (auto& v : s.digital_outputs)
-    v = static_cast<std::uint16_t>(r.unsignedValue("digital outputs", 16));
+    v = static_cast<std::uint16_t>(r.unsignedValue("digital outputs", 8));
   s.reserved = static_cast<std::uint16_t>(r.unsignedValue("reserved", 16));
   s.scan_frequency = static_cast<std::uint32_t>(r.unsignedValue("scan frequency"));
   s.measurement_frequency = static_cast<std::uint32_t>(r.unsignedValue("measurement frequency"));
@@ -158,7 +149,7 @@ ScanTelegram parseScanTelegram(const std::string& text) {
   }
   if (readFlag(r, "event flag")) {
     ScanEvent e;
-    e.type = r.characters("event type", 4);
+    e.type = r.label("event type", EVENT_TYPE_WIDTH);
     e.encoder_position = static_cast<std::uint32_t>(r.unsignedValue("event encoder position"));
     e.time_us = static_cast<std::uint32_t>(r.unsignedValue("event time"));
     e.angle = r.signedValue("event angle");
@@ -173,74 +164,76 @@ ScanTelegram parseScanTelegram(const std::string& text) {
   return s;
 }
 
-std::string encodeScanTelegram(const ScanTelegram& s) {
-  std::string out = (s.command_type.empty() ? std::string("sSN") : s.command_type) + " LMDscandata";
-  auto add = [&](const std::string& t) { out += " " + t; };
-  add(hex(s.version));
-  add(hex(s.device_number));
-  add(hex(s.serial_number));
-  add(hex(s.status_code));
-  add(hex(s.device_status));
-  add(hex(s.telegram_counter));
-  add(hex(s.scan_counter));
-  add(hex(s.time_since_startup_us));
-  add(hex(s.time_of_transmission_us));
+std::string encodeScanTelegram(const ScanTelegram& s, Protocol protocol) {
+  const auto writer = makeWriter(protocol);
+  FieldWriter& w = *writer;
+  w.word(s.command_type.empty() ? std::string("sSN") : s.command_type);
+  w.word("LMDscandata");
+  w.unsignedValue(s.version, 16);
+  w.unsignedValue(s.device_number, 16);
+  w.unsignedValue(s.serial_number);
+  w.unsignedValue(s.status_code, 8);
+  w.unsignedValue(s.device_status, 8);
+  w.unsignedValue(s.telegram_counter, 16);
+  w.unsignedValue(s.scan_counter, 16);
+  w.unsignedValue(s.time_since_startup_us);
+  w.unsignedValue(s.time_of_transmission_us);
   for (const auto v : s.digital_inputs)
-    add(hex(v));
+    w.unsignedValue(v, 8);
   for (const auto v : s.digital_outputs)
-    add(hex(v));
-  add(hex(s.reserved));
-  add(hex(s.scan_frequency));
-  add(hex(s.measurement_frequency));
-  add(hex(s.encoders.size()));
+    w.unsignedValue(v, 8);
+  w.unsignedValue(s.reserved, 16);
+  w.unsignedValue(s.scan_frequency);
+  w.unsignedValue(s.measurement_frequency);
+  w.unsignedValue(s.encoders.size(), 16);
   for (const auto& e : s.encoders) {
-    add(hex(e.position));
-    add(hex(e.speed));
+    w.unsignedValue(e.position);
+    w.unsignedValue(e.speed, 16);
   }
   for (const auto* channels : {&s.channels16, &s.channels8}) {
-    add(hex(channels->size()));
+    const int bits = channels == &s.channels16 ? 16 : 8;
+    w.unsignedValue(channels->size(), 16);
     for (const auto& c : *channels) {
-      add(c.name);
-      add(hexFloat(c.scale));
-      add(hexFloat(c.offset));
-      add(hexSigned(c.start_angle));
-      add(hex(c.angular_step));
-      add(hex(c.values.size()));
+      w.label(c.name, CHANNEL_NAME_WIDTH);
+      w.floatValue(c.scale);
+      w.floatValue(c.offset);
+      w.signedValue(c.start_angle);
+      w.unsignedValue(c.angular_step, 16);
+      w.unsignedValue(c.values.size(), 16);
       for (const auto v : c.values)
-        add(hex(v));
+        w.unsignedValue(v, bits);
     }
   }
-  add(s.position ? "1" : "0");
+  w.unsignedValue(s.position ? 1 : 0, 16);
   if (s.position) {
     for (const float f : {s.position->x, s.position->y, s.position->z, s.position->rot_x,
                           s.position->rot_y, s.position->rot_z})
-      add(hexFloat(f));
-    add(hex(s.position->rotation_type));
+      w.floatValue(f);
+    w.unsignedValue(s.position->rotation_type, 8);
   }
   for (const auto* text : {&s.device_name, &s.comment}) {
-    add(*text ? "1" : "0");
+    w.unsignedValue(*text ? 1 : 0, 16);
     if (*text) {
-      add(hex((*text)->size()));
-      add(**text);
+      w.unsignedValue((*text)->size(), 16);
+      w.characters(**text);
     }
   }
-  add(s.timestamp ? "1" : "0");
+  w.unsignedValue(s.timestamp ? 1 : 0, 16);
   if (s.timestamp) {
     const auto& t = *s.timestamp;
-    for (const std::uint64_t v :
-         {std::uint64_t{t.year}, std::uint64_t{t.month}, std::uint64_t{t.day},
-          std::uint64_t{t.hour}, std::uint64_t{t.minute}, std::uint64_t{t.second},
-          std::uint64_t{t.microsecond}})
-      add(hex(v));
+    w.unsignedValue(t.year, 16);
+    for (const std::uint64_t v : {t.month, t.day, t.hour, t.minute, t.second})
+      w.unsignedValue(v, 8);
+    w.unsignedValue(t.microsecond);
   }
-  add(s.event ? "1" : "0");
+  w.unsignedValue(s.event ? 1 : 0, 16);
   if (s.event) {
-    add(s.event->type);
-    add(hex(s.event->encoder_position));
-    add(hex(s.event->time_us));
-    add(hexSigned(s.event->angle));
+    w.label(s.event->type, EVENT_TYPE_WIDTH);
+    w.unsignedValue(s.event->encoder_position);
+    w.unsignedValue(s.event->time_us);
+    w.signedValue(s.event->angle);
   }
-  return out;
+  return w.payload();
 }
 
 std::string scanTelegramToJson(const ScanTelegram& s) {

@@ -38,8 +38,11 @@ void Lms111Config::validate() const {
           "scan_frequency_hz must be 25 or 50");
   require((angular_resolution_deg == 0.25) == (scan_frequency_hz == 25.0),
           "the LMS111 pairs 0.25 deg with 25 Hz and 0.5 deg with 50 Hz");
-  require(start_angle_deg >= -45.0 && stop_angle_deg <= 225.0 && start_angle_deg < stop_angle_deg,
-          "angles must satisfy -45 <= start < stop <= 225 deg");
+  // The device's last beam is at 225 deg inclusive (1081 beams), so the exclusive stop may
+  // lie one step beyond it.
+  require(start_angle_deg >= -45.0 && stop_angle_deg <= 225.0 + angular_resolution_deg &&
+              start_angle_deg < stop_angle_deg,
+          "angles must satisfy -45 <= start < stop <= 225 deg + one step");
   require(min_range >= 0.0 && max_range > min_range, "need 0 <= min_range < max_range");
   require(range_noise_sigma >= 0.0, "range_noise_sigma must be >= 0");
   require(std::abs(range_bias) < 1.0, "range_bias must be within +/-1 m");

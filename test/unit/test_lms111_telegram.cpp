@@ -5,6 +5,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/cola.h"
+#include "dormant_tree_modeling/lms111/cola_fields.h"
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
 
 namespace dormant_tree_modeling {
@@ -106,6 +107,55 @@ TEST(ScanTelegram, EncodeParseRoundTripWithEveryBlock) {
   EXPECT_EQ(back.event->angle, -12345);
   // The real telegram itself re-encodes to its own text.
   EXPECT_EQ(encodeScanTelegram(parseScanTelegram(realTelegram())), realTelegram());
+}
+
+TEST(ScanTelegram, EveryOptionalBlockCombinationRoundTripsInBothProtocols) {
+  const ScanTelegram real = parseScanTelegram(realTelegram());
+  for (int mask = 0; mask < 32; ++mask) {
+    ScanTelegram s = real;
+    s.encoders = {{0xDEADBEEF, 300}};
+    ScanChannel rssi = s.channels16[0];
+    rssi.name = "RSSI1";
+    for (auto& v : rssi.values)
+      v = static_cast<std::uint16_t>(v & 0xFF);
+    s.channels8.push_back(rssi);
+    if (mask & 1)
+      s.position = ScanPosition{0.5f, 1.0f, 2.0f, 0.0f, 0.0f, 3.14f, 0};
+    if (mask & 2)
+      s.device_name = "LMS 111";
+    if (mask & 4)
+      s.comment = "row 7 tree 3";
+    if (mask & 8)
+      s.timestamp = ScanTimestamp{2026, 3, 4, 5, 6, 7, 890123};
+    if (mask & 16)
+      s.event = ScanEvent{"FDIN", 1, 2, -3};
+    for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
+      const std::string payload = encodeScanTelegram(s, p);
+      const ScanTelegram back = parseScanTelegram(payload, p);
+      EXPECT_EQ(encodeScanTelegram(back, p), payload) << "mask " << mask << " " << protocolName(p);
+      EXPECT_EQ(back.channels16[0].values, s.channels16[0].values);
+      EXPECT_EQ(back.channels8[0].values, rssi.values);
+      EXPECT_EQ(back.comment, s.comment);
+      EXPECT_EQ(back.device_name, s.device_name);
+      EXPECT_EQ(back.event.has_value(), s.event.has_value());
+    }
+  }
+}
+
+TEST(ScanTelegram, ColaBIsBinaryAndChecked) {
+  const ScanTelegram real = parseScanTelegram(realTelegram());
+  const std::string b = encodeScanTelegram(real, Protocol::COLA_B);
+  EXPECT_EQ(b.compare(0, 16, "sSN LMDscandata "), 0);
+  // 541 16-bit values dominate: about 2 bytes a beam instead of ~4 characters.
+  EXPECT_LT(b.size(), 541u * 2 + 120u);
+  EXPECT_THROW(parseScanTelegram(b.substr(0, b.size() - 3), Protocol::COLA_B), Error);
+  EXPECT_THROW(parseScanTelegram(b + "x", Protocol::COLA_B), Error);
+  ScanTelegram bad = real;
+  bad.channels16[0].name = "DIST";  // CoLa-B names are 5 characters
+  EXPECT_THROW(encodeScanTelegram(bad, Protocol::COLA_B), Error);
+  bad = real;
+  bad.digital_inputs[0] = 256;  // 8 bits on the wire
+  EXPECT_THROW(encodeScanTelegram(bad, Protocol::COLA_B), Error);
 }
 
 TEST(ScanTelegram, InconsistentTelegramsAreRejectedWithAReason) {

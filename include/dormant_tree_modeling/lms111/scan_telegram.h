@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/lms111/cola.h"
+
 namespace dormant_tree_modeling {
 namespace lms111 {
 
@@ -83,16 +85,22 @@ struct ScanTelegram {
   }
 };
 
-/// @brief Decode a CoLa-A `LMDscandata` telegram (text without STX/ETX) by walking its
-/// structure: any number of encoders and channels, the optional blocks, strings with spaces.
+/// @brief Decode an `LMDscandata` telegram payload (without STX/ETX or the CoLa-B frame) by
+/// walking its structure: any number of encoders and channels, the optional blocks, strings
+/// with spaces. CoLa-B carries the same fields big-endian with these widths: version, device
+/// number, counters, digital inputs/outputs 2 x 8 bit, reserved, counts, angular step and flags
+/// 16 bit; serial, times, frequencies, encoder position 32 bit; channel names 5 and event types
+/// 4 characters; scale, offset IEEE-754; start angle int32; values 16 or 8 bit.
 /// @throws Error PARSE_ERROR with the field and position for a telegram that is not
 ///         `LMDscandata`, is cut short, has a non-number where a number belongs, a count that
 ///         does not match the values, or text left over at the end
-ScanTelegram parseScanTelegram(const std::string& text);
+ScanTelegram parseScanTelegram(const std::string& payload, Protocol protocol = Protocol::COLA_A);
 
-/// @brief Encode a scan as the device sends it in CoLa-A (text without STX/ETX); the inverse
-/// of parseScanTelegram, used by the emulator and for round-trip tests.
-std::string encodeScanTelegram(const ScanTelegram& scan);
+/// @brief Encode a scan as the device sends it (payload without framing); the inverse of
+/// parseScanTelegram, used by the emulator and for round-trip tests.
+/// @throws Error INVALID_ARGUMENT when a value does not fit its field (e.g. a CoLa-B channel
+///         name that is not 5 characters)
+std::string encodeScanTelegram(const ScanTelegram& scan, Protocol protocol = Protocol::COLA_A);
 
 /// @brief The telegram as JSON: every header field, each channel with its name, scale, offset,
 /// start angle and step in degrees, count and values (scripts/lms111_decode).

@@ -1,0 +1,139 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/lms111/cola.h"
+#include "dormant_tree_modeling/lms111/cola_fields.h"
+#include "dormant_tree_modeling/lms111/scan_source.h"
+#include "dormant_tree_modeling/lms111/scan_telegram.h"
+
+namespace dormant_tree_modeling {
+namespace lms111 {
+
+/// @brief The password hash of the "authorised client" access level 3 (docs/hardware.md).
+constexpr std::uint32_t AUTHORISED_CLIENT_PASSWORD = 0xF4724744;
+constexpr int AUTHORISED_CLIENT_LEVEL = 3;
+/// @brief `STlms` state "ready for measurement".
+constexpr int STATE_READY_FOR_MEASUREMENT = 7;
+
+/// @brief Scan configuration as the device holds it, in the device's units.
+struct DeviceScanConfig {
+  std::uint32_t frequency = 2500;      ///< 1/100 Hz
+  std::uint32_t resolution = 2500;     ///< 1/10000 deg
+  std::int32_t start_angle = -450000;  ///< 1/10000 deg, first beam
+  std::int32_t stop_angle = 2250000;   ///< 1/10000 deg, last beam (inclusive)
+
+  /// @brief Beams per scan.
+  int count() const { return static_cast<int>((stop_angle - start_angle) / resolution) + 1; }
+};
+
+/// @brief What `LMDscandatacfg` selects for the scan telegrams.
+struct DataOutputConfig {
+  bool rssi = false;
+  bool device_name = false;
+  bool comment = false;
+  bool time_stamp = false;
+  std::uint16_t output_interval = 1;  ///< send every n-th scan
+};
+
+/// @brief Failures an emulated device can be told to show, for tests. Counts refer to scan
+/// telegrams sent since the emulator (re)started; 0 switches a fault off.
+struct EmulatorFaults {
+  std::size_t drop_after = 0;   ///< close every connection once after this many telegrams
+  std::size_t stall_after = 0;  ///< then send nothing (and answer nothing) for stall_seconds
+  double stall_seconds = 2.0;
+  std::size_t trickle_bytes = 0;  ///< write telegrams in pieces of this many bytes
+  std::size_t corrupt_every = 0;  ///< flip one byte in every n-th telegram
+  std::size_t restart_after = 0;  ///< reboot: close everything, reset, listen again after
+  double restart_seconds = 1.0;   ///< restart_seconds
+  /// Command name -> sFA code to answer instead, and how often (< 0: always).
+  struct SfaFault {
+    int code = 0;
+    int times = 1;
+  };
+  std::map<std::string, SfaFault> sfa;
+
+  /// @brief Add an sFA fault from "NAME:CODE[:TIMES]", e.g. "mLMPsetscancfg:8:2".
+  /// @throws Error INVALID_ARGUMENT for a malformed specification
+  void addSfa(const std::string& specification);
+};
+
+/// @brief Identity and timing of an emulated device.
+struct EmulatorConfig {
+  std::uint32_t serial_number = 0x00A037B9;
+  std::string device_name = "LMS111-10100";
+  std::string firmware_version = "V1.10";
+  double spin_up_seconds = 0.3;      ///< LMCstartmeas or Run until ready for measurement, s
+  double clock_drift_ppm = 0.0;      ///< device oscillator error against the host clock
+  std::uint32_t clock_start_us = 0;  ///< device clock at power-up (set near 2^32 to test wrap)
+  DeviceScanConfig scan;             ///< the configuration it powers up with
+};
+
+/// @brief One client connection's view of the device.
+struct EmulatorSession {
+  Protocol protocol = Protocol::COLA_A;
+  int access_level = 0;
+  bool streaming = false;
+};
+
+/// @brief The device's command interpreter and state machine, without any I/O: the server
+/// feeds it request payloads and the time, and sends what it returns. Implements the commands
+/// the driver uses (docs/hardware.md): SetAccessMode, mLMPsetscancfg, LMPscancfg,
+/// LMPoutputRange, LMDscandatacfg, LMCstartmeas, LMCstopmeas, STlms, Run, DeviceIdent,
+/// LMDscandata (event and poll), with `sFA` replies to unknown commands, missing access, wrong
+/// state and bad data.
+class EmulatedLms111 {
+ public:
+  /// @param source scan content; shared with the caller
+  EmulatedLms111(EmulatorConfig config, std::shared_ptr<ScanSource> source,
+                 EmulatorFaults faults = {});
+
+  /// @brief Replies to one request payload (usually one; none for an unanswered stall).
+  /// @param now_s seconds since the emulator started (steady clock)
+  std::vector<std::string> handle(const std::string& payload, EmulatorSession& session,
+                                  double now_s);
+
+  /// @brief `STlms` state at a time.
+  int state(double now_s) const;
+  /// @brief Seconds between two scans at the active configuration.
+  double scanPeriod() const { return 100.0 / config_.scan.frequency; }
+  /// @brief The next scan telegram, its first ray at now_s; advances the counters. Empty
+  /// when the device is not ready, or the output interval skips this scan.
+  std::optional<ScanTelegram> nextScan(double now_s);
+  /// @brief Device clock (µs since power-up, wrapping at 2^32) at a time.
+  std::uint32_t clockUs(double now_s) const;
+  /// @brief Reboot: configuration back to the power-up values, counters and clock restart.
+  void powerUp(double now_s);
+
+  const EmulatorFaults& faults() const { return faults_; }
+  const DeviceScanConfig& scanConfig() const { return active_; }
+  const DataOutputConfig& outputConfig() const { return output_; }
+
+ private:
+  std::string reply(const EmulatorSession& session, const std::string& type,
+                    const std::string& name,
+                    const std::function<void(FieldWriter&)>& fields = {}) const;
+  std::string sfa(const EmulatorSession& session, int code) const;
+  std::optional<std::string> dispatch(const std::string& type, const std::string& name,
+                                      FieldReader& args, EmulatorSession& session, double now_s);
+
+  EmulatorConfig config_;
+  std::shared_ptr<ScanSource> source_;
+  EmulatorFaults faults_;
+  DeviceScanConfig active_, pending_;
+  DataOutputConfig output_;
+  bool measuring_ = true;
+  double power_up_s_ = 0.0;
+  double ready_at_s_ = 0.0;
+  std::uint16_t telegram_counter_ = 0, scan_counter_ = 0;
+  std::uint64_t scans_ = 0;
+};
+
+}  // namespace lms111
+}  // namespace dormant_tree_modeling

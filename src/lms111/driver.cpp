@@ -1,0 +1,472 @@
+#include "dormant_tree_modeling/lms111/driver.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/cola_fields.h"
+#include "dormant_tree_modeling/lms111/device_emulator.h"
+#include "dormant_tree_modeling/lms111/tcp_connection.h"
+
+namespace dormant_tree_modeling {
+namespace lms111 {
+
+namespace {
+
+constexpr double STATE_POLL_S = 0.1;
+constexpr double STOP_REPLY_TIMEOUT_S = 0.5;
+constexpr double MIN_SCAN_TIMEOUT_S = 0.2;
+
+double steadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// The device answered a request with sFA.
+struct DeviceRefusal : Error {
+  DeviceRefusal(const std::string& command, int code)
+      : Error(ErrorCode::IO_FAILURE, "the device refused " + command + " with sFA " +
+                                         std::to_string(code) + ": " + describeSfaError(code)),
+        code(code) {}
+  int code;
+};
+
+}  // namespace
+
+int DriverConfig::beamCount() const {
+  return static_cast<int>((stopUnits() - startUnits()) /
+                          static_cast<std::int64_t>(resolutionUnits())) +
+         1;
+}
+std::uint32_t DriverConfig::frequencyUnits() const {
+  return static_cast<std::uint32_t>(std::lround(scan_frequency_hz * 100.0));
+}
+std::uint32_t DriverConfig::resolutionUnits() const {
+  return static_cast<std::uint32_t>(std::lround(angular_resolution_deg * 10000.0));
+}
+std::int32_t DriverConfig::startUnits() const {
+  return static_cast<std::int32_t>(std::lround(start_angle_deg * 10000.0));
+}
+std::int32_t DriverConfig::stopUnits() const {
+  return static_cast<std::int32_t>(std::lround(stop_angle_deg * 10000.0));
+}
+
+void DriverConfig::validate() const {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok)
+      throw Error(ErrorCode::INVALID_ARGUMENT, "lms111 driver: " + message);
+  };
+  require(!host.empty(), "host must not be empty");
+  require(port > 0 && port < 65536, "port must be in 1..65535, is " + std::to_string(port));
+  require((scan_frequency_hz == 25.0 && angular_resolution_deg == 0.25) ||
+              (scan_frequency_hz == 50.0 && angular_resolution_deg == 0.5),
+          "the LMS111 runs 25 Hz with 0.25 deg or 50 Hz with 0.5 deg (asked: " +
+              std::to_string(scan_frequency_hz) + " Hz, " + std::to_string(angular_resolution_deg) +
+              " deg)");
+  require(start_angle_deg >= -45.0 && stop_angle_deg <= 225.0 && start_angle_deg < stop_angle_deg,
+          "angles must satisfy -45 <= start_angle_deg < stop_angle_deg <= 225");
+  require((stopUnits() - startUnits()) % static_cast<std::int64_t>(resolutionUnits()) == 0,
+          "stop_angle_deg - start_angle_deg must be a multiple of the resolution");
+  require(connect_timeout_s > 0 && reply_timeout_s > 0 && ready_timeout_s > 0,
+          "timeouts must be > 0");
+  require(scan_timeout_periods >= 2.0, "scan_timeout_periods must be >= 2");
+  require(reconnect_min_s > 0 && reconnect_max_s >= reconnect_min_s,
+          "need 0 < reconnect_min_s <= reconnect_max_s");
+}
+
+const char* driverStateName(DriverState state) {
+  switch (state) {
+    case DriverState::STOPPED:
+      return "stopped";
+    case DriverState::CONNECTING:
+      return "connecting";
+    case DriverState::CONFIGURING:
+      return "configuring";
+    case DriverState::STREAMING:
+      return "streaming";
+    case DriverState::BACKING_OFF:
+      return "backing off";
+  }
+  return "?";
+}
+
+// One connection's conversation with the device: requests, replies, the stream.
+class Lms111Driver::Session {
+ public:
+  explicit Session(Lms111Driver& driver)
+      : d_(driver), c_(driver.config_), framer_(makeFramer(c_.protocol)) {}
+
+  void connect() { connection_.connect(c_.host, c_.port, c_.connect_timeout_s); }
+
+  // Sends a request, waits for its reply (type + name) and hands back a reader positioned at
+  // the reply's arguments. Scan telegrams that arrive meanwhile are ignored.
+  std::unique_ptr<FieldReader> request(const std::string& type, const std::string& name,
+                                       const std::function<void(FieldWriter&)>& args = {},
+                                       double timeout_s = -1.0) {
+    const auto w = makeWriter(c_.protocol);
+    w->word(type);
+    w->word(name);
+    if (args)
+      args(*w);
+    const double timeout = timeout_s > 0 ? timeout_s : c_.reply_timeout_s;
+    connection_.send(frame(c_.protocol, w->payload()), timeout);
+    const std::string expected = replyType(type);
+    const double deadline = steadySeconds() + timeout;
+    for (;;) {
+      const auto payload = nextPayload(deadline - steadySeconds());
+      if (!payload) {
+        throw Error(ErrorCode::IO_FAILURE, "no reply to " + type + " " + name + " within " +
+                                               std::to_string(timeout) + " s");
+      }
+      auto r = makeReader(c_.protocol, *payload);
+      const std::string got_type = r->word("reply type");
+      if (got_type == "sFA")
+        throw DeviceRefusal(type + " " + name,
+                            static_cast<int>(r->unsignedValue("error code", 16)));
+      if (got_type == "sSN")
+        continue;  // a scan still in flight from an earlier stream
+      const std::string got_name = r->word("reply name");
+      if (got_type == expected && got_name == name)
+        return r;
+      d_.log(1, "ignored an unexpected reply '" + got_type + " " + got_name + "' to " + type + " " +
+                    name);
+    }
+  }
+
+  // The next framed payload within the timeout, or nothing.
+  std::optional<std::string> nextPayload(double timeout_s) {
+    const double deadline = steadySeconds() + std::max(0.0, timeout_s);
+    for (;;) {
+      if (auto p = framer_->next())
+        return p;
+      const double left = deadline - steadySeconds();
+      if (left <= 0 || d_.stopping_)
+        return std::nullopt;
+      // Short slices, so that stop() is honoured promptly.
+      const std::string bytes = connection_.receiveSome(std::min(left, 0.1));
+      framer_->feed(bytes.data(), bytes.size());
+      const std::size_t discarded = framer_->discarded();
+      if (discarded > discarded_) {
+        std::lock_guard<std::mutex> lock(d_.mutex_);
+        d_.stats_.discarded_bytes += discarded - discarded_;
+      }
+      discarded_ = discarded;
+    }
+  }
+
+  void configure() {
+    {
+      auto r = request("sRN", "DeviceIdent");
+      const auto n = r->unsignedValue("name length", 16);
+      std::string ident = r->characters("name", n);
+      const auto m = r->unsignedValue("version length", 16);
+      ident += " " + r->characters("version", m);
+      std::lock_guard<std::mutex> lock(d_.mutex_);
+      d_.stats_.device_ident = ident;
+    }
+    auto login = request("sMN", "SetAccessMode", [](FieldWriter& w) {
+      w.unsignedValue(AUTHORISED_CLIENT_LEVEL, 8);
+      w.unsignedValue(AUTHORISED_CLIENT_PASSWORD);
+    });
+    if (login->unsignedValue("result", 8) != 1)
+      throw Error(ErrorCode::IO_FAILURE, "the device refused the authorised-client login");
+    setScanConfig();
+    request("sWN", "LMPoutputRange", [this](FieldWriter& w) {
+      w.unsignedValue(1, 16);
+      w.unsignedValue(c_.resolutionUnits());
+      w.signedValue(c_.startUnits());
+      w.signedValue(c_.stopUnits());
+    });
+    request("sWN", "LMDscandatacfg", [this](FieldWriter& w) {
+      w.unsignedValue(1, 16);               // DIST1
+      w.unsignedValue(c_.rssi ? 1 : 0, 8);  // remission
+      w.unsignedValue(0, 8);                // 8-bit remission values
+      w.unsignedValue(0, 8);                // distances in mm
+      w.unsignedValue(0, 16);               // no encoder
+      w.unsignedValue(0, 8);                // no position block
+      w.unsignedValue(0, 8);                // no device name
+      w.unsignedValue(0, 8);                // no comment
+      w.unsignedValue(0, 8);                // no time block: the µs clock is what we map
+      w.unsignedValue(1, 16);               // every scan
+    });
+    request("sMN", "LMCstartmeas");
+    request("sMN", "Run");
+    waitUntilReady();
+    verifyScanConfig();
+    request("sEN", "LMDscandata", [](FieldWriter& w) { w.unsignedValue(1, 8); });
+  }
+
+  // Some firmware refuses mLMPsetscancfg (sFA 8 or 11) although it already runs the asked
+  // configuration; others answer sFA 4 to the first configuration after power-up. Read back
+  // what the device runs and carry on only if it matches.
+  void setScanConfig() {
+    try {
+      auto r = request("sMN", "mLMPsetscancfg", [this](FieldWriter& w) {
+        w.unsignedValue(c_.frequencyUnits());
+        w.unsignedValue(1, 16);
+        w.unsignedValue(c_.resolutionUnits());
+        w.signedValue(c_.startUnits());
+        w.signedValue(c_.stopUnits());
+      });
+      const auto result = r->unsignedValue("result", 8);
+      if (result != 0) {
+        static const char* WHY[] = {"", "frequency not supported", "resolution not supported",
+                                    "frequency and resolution not supported",
+                                    "scan area not supported"};
+        throw Error(ErrorCode::INVALID_ARGUMENT,
+                    std::string("the device rejected the scan configuration: ") +
+                        (result < 5 ? WHY[result] : "error " + std::to_string(result)));
+      }
+    } catch (const DeviceRefusal& e) {
+      d_.log(1, std::string(e.what()) +
+                    "; checking whether it already runs the asked "
+                    "configuration");
+    }
+  }
+
+  void waitUntilReady() {
+    const double deadline = steadySeconds() + c_.ready_timeout_s;
+    int state = -1;
+    while (steadySeconds() < deadline && !d_.stopping_) {
+      auto r = request("sRN", "STlms");
+      state = static_cast<int>(r->unsignedValue("state", 16));
+      if (state == STATE_READY_FOR_MEASUREMENT)
+        return;
+      d_.sleepFor(STATE_POLL_S);
+    }
+    throw Error(ErrorCode::IO_FAILURE, "the device did not become ready for measurement within " +
+                                           std::to_string(c_.ready_timeout_s) +
+                                           " s (state: " + deviceStateName(state) + ")");
+  }
+
+  void verifyScanConfig() {
+    auto r = request("sRN", "LMPscancfg");
+    const auto frequency = r->unsignedValue("scan frequency");
+    r->unsignedValue("sectors", 16);
+    const auto resolution = r->unsignedValue("resolution");
+    if (frequency != c_.frequencyUnits() || resolution != c_.resolutionUnits()) {
+      std::ostringstream m;
+      m << "the device runs " << frequency / 100.0 << " Hz / " << resolution / 10000.0
+        << " deg, not the requested " << c_.scan_frequency_hz << " Hz / "
+        << c_.angular_resolution_deg << " deg";
+      throw Error(ErrorCode::INVALID_ARGUMENT, m.str());
+    }
+  }
+
+  // The scans themselves are the authority: LMPoutputRange can misreport the resolution.
+  void verifyScan(const ScanTelegram& s) const {
+    const ScanChannel* dist = s.channel("DIST1");
+    std::ostringstream m;
+    if (!dist) {
+      m << "the scans carry no DIST1 channel";
+    } else if (s.scan_frequency != c_.frequencyUnits() ||
+               dist->angular_step != c_.resolutionUnits()) {
+      m << "the device streams " << s.scanFrequencyHz() << " Hz / " << dist->stepDeg()
+        << " deg, not the requested " << c_.scan_frequency_hz << " Hz / "
+        << c_.angular_resolution_deg << " deg";
+    } else if (dist->start_angle != c_.startUnits() ||
+               static_cast<int>(dist->values.size()) != c_.beamCount()) {
+      m << "the device streams " << dist->values.size() << " beams from " << dist->startAngleDeg()
+        << " deg, not the requested " << c_.beamCount() << " from " << c_.start_angle_deg << " deg";
+    } else if (c_.rssi && !s.channel("RSSI1")) {
+      m << "the scans carry no RSSI1 channel although it was requested";
+    } else {
+      return;
+    }
+    throw Error(ErrorCode::INVALID_ARGUMENT, m.str());
+  }
+
+  void stream() {
+    const double period = 1.0 / c_.scan_frequency_hz;
+    const double timeout = std::max(MIN_SCAN_TIMEOUT_S, c_.scan_timeout_periods * period);
+    bool verified = false;
+    std::optional<std::uint16_t> last_counter;
+    while (!d_.stopping_) {
+      const auto payload = nextPayload(timeout);
+      if (d_.stopping_)
+        return;
+      if (!payload) {
+        throw Error(ErrorCode::IO_FAILURE, "no scan within " + std::to_string(timeout) +
+                                               " s (device silent or connection half-open)");
+      }
+      const double received = d_.clock_();
+      ScanTelegram scan;
+      try {
+        scan = parseScanTelegram(*payload, c_.protocol);
+      } catch (const Error& e) {
+        if (payload->compare(0, 3, "sSN") != 0 && payload->compare(0, 3, "sRA") != 0)
+          continue;  // a late reply, not a scan
+        std::lock_guard<std::mutex> lock(d_.mutex_);
+        ++d_.stats_.parse_errors;
+        d_.stats_.last_error = std::string("parse error: ") + e.what();
+        continue;
+      }
+      if (!verified) {
+        verifyScan(scan);
+        verified = true;
+        d_.last_logged_error_.clear();  // the next failure is news again
+        std::lock_guard<std::mutex> lock(d_.mutex_);
+        ++d_.stats_.connects;
+      }
+      d_.setState(DriverState::STREAMING);
+      if (d_.clock_mapper_.observe(scan.time_of_transmission_us, received))
+        d_.log(1, "the device clock restarted (device reboot?): clock mapping reset");
+      StampedScan out;
+      out.received_s = received;
+      out.stamp_s = d_.clock_mapper_.toHost(scan.time_since_startup_us).value_or(received);
+      {
+        std::lock_guard<std::mutex> lock(d_.mutex_);
+        ++d_.stats_.scans;
+        if (last_counter) {
+          const std::uint16_t step = static_cast<std::uint16_t>(scan.scan_counter - *last_counter);
+          if (step > 1)
+            d_.stats_.scan_gaps += step - 1;
+        }
+        d_.stats_.device_status = scan.device_status;
+      }
+      last_counter = scan.scan_counter;
+      out.telegram = std::move(scan);
+      if (d_.on_scan_)
+        d_.on_scan_(out);
+    }
+  }
+
+  // Best effort: the device may be gone already.
+  void stopStream() {
+    if (!connection_.isOpen())
+      return;
+    try {
+      request(
+          "sEN", "LMDscandata", [](FieldWriter& w) { w.unsignedValue(0, 8); },
+          STOP_REPLY_TIMEOUT_S);
+    } catch (const Error&) {
+    }
+    connection_.close();
+  }
+
+ private:
+  static std::string replyType(const std::string& type) {
+    if (type == "sRN")
+      return "sRA";
+    if (type == "sWN")
+      return "sWA";
+    if (type == "sMN")
+      return "sAN";
+    if (type == "sEN")
+      return "sEA";
+    return type;
+  }
+
+  Lms111Driver& d_;
+  const DriverConfig& c_;
+  TcpConnection connection_;
+  std::unique_ptr<Framer> framer_;
+  std::size_t discarded_ = 0;
+};
+
+Lms111Driver::Lms111Driver(DriverConfig config, ScanCallback on_scan, LogCallback log,
+                           ClockFunction clock)
+    : config_(std::move(config)),
+      on_scan_(std::move(on_scan)),
+      log_(std::move(log)),
+      clock_(std::move(clock)) {
+  config_.validate();
+  if (!clock_) {
+    clock_ = [] {
+      return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+          .count();
+    };
+  }
+}
+
+Lms111Driver::~Lms111Driver() {
+  stop();
+}
+
+void Lms111Driver::start() {
+  if (thread_.joinable())
+    return;
+  stopping_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void Lms111Driver::stop() {
+  stopping_ = true;
+  if (thread_.joinable())
+    thread_.join();
+  setState(DriverState::STOPPED);
+}
+
+DriverStatistics Lms111Driver::statistics() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+void Lms111Driver::setState(DriverState state) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stats_.state = state;
+}
+
+void Lms111Driver::log(int severity, const std::string& message) {
+  if (log_)
+    log_(severity, message);
+}
+
+bool Lms111Driver::sleepFor(double seconds) {
+  const double end = steadySeconds() + seconds;
+  while (!stopping_) {
+    const double left = end - steadySeconds();
+    if (left <= 0)
+      return true;
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, 0.05)));
+  }
+  return false;
+}
+
+void Lms111Driver::run() {
+  double backoff = config_.reconnect_min_s;
+  const std::string where = config_.host + ":" + std::to_string(config_.port) + " (" +
+                            protocolName(config_.protocol) + ")";
+  while (!stopping_) {
+    Session session(*this);
+    try {
+      setState(DriverState::CONNECTING);
+      session.connect();
+      setState(DriverState::CONFIGURING);
+      session.configure();
+      log(0, "LMS111 at " + where + " configured: " + std::to_string(config_.scan_frequency_hz) +
+                 " Hz, " + std::to_string(config_.angular_resolution_deg) + " deg, " +
+                 std::to_string(config_.beamCount()) + " beams");
+      // A device that rebooted has a new clock; a mapping across connections is not trusted.
+      clock_mapper_.reset();
+      session.stream();
+      session.stopStream();
+    } catch (const Error& e) {
+      session.stopStream();
+      if (stopping_)
+        break;
+      const bool streamed = statistics().state == DriverState::STREAMING;
+      if (streamed)
+        backoff = config_.reconnect_min_s;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        ++stats_.failures;
+        stats_.last_error = e.what();
+      }
+      // One message per kind of failure, not one per retry.
+      if (e.what() != last_logged_error_) {
+        log(2, "LMS111 at " + where + ": " + e.what() + "; retrying in " + std::to_string(backoff) +
+                   " s");
+        last_logged_error_ = e.what();
+      }
+      setState(DriverState::BACKING_OFF);
+      if (!sleepFor(backoff))
+        break;
+      backoff = std::min(config_.reconnect_max_s, backoff * 2.0);
+    }
+  }
+  setState(DriverState::STOPPED);
+}
+
+}  // namespace lms111
+}  // namespace dormant_tree_modeling

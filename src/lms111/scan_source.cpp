@@ -1,0 +1,70 @@
+#include "dormant_tree_modeling/lms111/scan_source.h"
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/cola.h"
+
+namespace dormant_tree_modeling {
+namespace lms111 {
+
+std::string telegramText(const std::string& data) {
+  if (data.find(STX) != std::string::npos) {
+    ColaAFramer framer;
+    framer.feed(data);
+    const auto telegram = framer.next();
+    if (!telegram)
+      throw Error(ErrorCode::PARSE_ERROR, "an STX without its ETX");
+    return *telegram;
+  }
+  std::string text = data;
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
+    text.pop_back();
+  return text;
+}
+
+std::string readTelegramFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot open telegram file " + path);
+  const std::string data((std::istreambuf_iterator<char>(in)), {});
+  return telegramText(data);
+}
+
+RecordedScanSource::RecordedScanSource(ScanTelegram telegram) : telegram_(std::move(telegram)) {
+  const ScanChannel* dist = telegram_.channel("DIST1");
+  if (!dist || dist->values.empty() || dist->angular_step == 0) {
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "a recorded scan needs a DIST1 channel with values and a non-zero step");
+  }
+}
+
+RecordedScanSource RecordedScanSource::fromFile(const std::string& path) {
+  return RecordedScanSource(parseScanTelegram(readTelegramFile(path)));
+}
+
+ScanContent RecordedScanSource::scan(const ScanGeometry& geometry, double, std::uint64_t) {
+  const ScanChannel& dist = *telegram_.channel("DIST1");
+  const ScanChannel* rssi = telegram_.channel("RSSI1");
+  ScanContent out;
+  out.distances_mm.assign(geometry.count, 0);
+  out.rssi.assign(geometry.count, 0);
+  const auto n = static_cast<long>(dist.values.size());
+  for (int i = 0; i < geometry.count; ++i) {
+    const long k = std::lround((geometry.angleDeg(i) - dist.startAngleDeg()) / dist.stepDeg());
+    if (k < 0 || k >= n)
+      continue;
+    out.distances_mm[i] =
+        static_cast<std::uint16_t>(std::lround(dist.values[k] * dist.scale + dist.offset));
+    if (rssi && k < static_cast<long>(rssi->values.size()))
+      out.rssi[i] = rssi->values[k];
+    else if (out.distances_mm[i] > 0)
+      out.rssi[i] = 200;  // the recording has no echo strength: report a plain bark echo
+  }
+  return out;
+}
+
+}  // namespace lms111
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,137 @@
+// lms111_emulator: a SICK LMS111 on 127.0.0.1 (CoLa-A and CoLa-B), scanning a synthetic
+// orchard or replaying a recorded telegram, with fault injection for tests.
+#include <boost/program_options.hpp>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+#include <thread>
+
+#include "command_line.h"
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/emulator_server.h"
+#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+#include "dormant_tree_modeling/simulation/orchard_generator.h"
+
+namespace po = boost::program_options;
+using namespace dormant_tree_modeling;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+void onSignal(int) {
+  g_stop = 1;
+}
+
+// roslaunch appends __name:=..., __log:=... (and remappings); they are not ours.
+std::vector<char*> withoutRosArguments(int argc, char** argv) {
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (i == 0 || std::string(argv[i]).find(":=") == std::string::npos)
+      args.push_back(argv[i]);
+  }
+  return args;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  lms111::EmulatorServerOptions server;
+  lms111::EmulatorConfig device;
+  lms111::EmulatorFaults faults;
+  std::string telegram, scene_path, preset = "young_tall_spindle";
+  std::uint64_t seed = 1;
+  double distance = 1.5, height = 1.5, noise_mm = 12.0, frequency = 25.0, duration = 0.0;
+  std::vector<std::string> sfa;
+  po::options_description desc(
+      "Usage: lms111_emulator [options]\n"
+      "Serves an emulated SICK LMS111 until SIGINT/SIGTERM (or --duration). Scans come from a "
+      "synthetic orchard seen from a fixed pose in front of its target tree, or from a recorded "
+      "telegram (--telegram).");
+  desc.add_options()("help,h", "this help")(
+      "address", po::value(&server.address)->default_value(server.address), "listen address")(
+      "cola-a-port", po::value(&server.cola_a_port)->default_value(server.cola_a_port),
+      "CoLa-A port (0: any free one, -1: off)")(
+      "cola-b-port", po::value(&server.cola_b_port)->default_value(server.cola_b_port),
+      "CoLa-B port (0: any free one, -1: off)")(
+      "telegram", po::value(&telegram), "replay this recorded LMDscandata telegram (text file)")(
+      "scene", po::value(&scene_path), "scan this scene (scene.json of synth_tree)")(
+      "preset", po::value(&preset)->default_value(preset), "synthetic orchard preset")(
+      "seed", po::value(&seed)->default_value(seed), "synthetic orchard seed")(
+      "distance", po::value(&distance)->default_value(distance),
+      "laser distance in front of the tree, m")("height", po::value(&height)->default_value(height),
+                                                "laser height, m")(
+      "noise-mm", po::value(&noise_mm)->default_value(noise_mm), "range noise, 1 sigma, mm")(
+      "frequency", po::value(&frequency)->default_value(frequency),
+      "power-up scan frequency, Hz: 25 (0.25 deg) or 50 (0.5 deg)")(
+      "spin-up", po::value(&device.spin_up_seconds)->default_value(device.spin_up_seconds),
+      "seconds from start of measurement to ready")(
+      "drift-ppm", po::value(&device.clock_drift_ppm)->default_value(0.0),
+      "device clock error, ppm")("clock-start-us", po::value(&device.clock_start_us),
+                                 "device clock at power-up, µs")(
+      "drop-after", po::value(&faults.drop_after), "fault: close connections after N telegrams")(
+      "stall-after", po::value(&faults.stall_after), "fault: go silent after N telegrams")(
+      "stall-seconds", po::value(&faults.stall_seconds)->default_value(faults.stall_seconds),
+      "fault: for this long")("trickle-bytes", po::value(&faults.trickle_bytes),
+                              "fault: send in pieces of N bytes")(
+      "corrupt-every", po::value(&faults.corrupt_every), "fault: corrupt every N-th telegram")(
+      "restart-after", po::value(&faults.restart_after), "fault: reboot after N telegrams")(
+      "restart-seconds", po::value(&faults.restart_seconds)->default_value(faults.restart_seconds),
+      "fault: reboot duration")("sfa", po::value(&sfa)->composing(),
+                                "fault: NAME:CODE[:TIMES] answer sFA CODE to command NAME")(
+      "duration", po::value(&duration)->default_value(duration), "seconds to run, 0 = forever");
+  try {
+    auto args = withoutRosArguments(argc, argv);
+    po::variables_map vm;
+    if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
+      return 0;
+    for (const auto& s : sfa)
+      faults.addSfa(s);
+    if (frequency != 25.0 && frequency != 50.0)
+      throw Error(ErrorCode::INVALID_ARGUMENT, "--frequency must be 25 or 50");
+    device.scan.frequency = frequency == 25.0 ? 2500 : 5000;
+    device.scan.resolution = device.scan.frequency;
+    std::shared_ptr<lms111::ScanSource> source;
+    if (!telegram.empty()) {
+      source = std::make_shared<lms111::RecordedScanSource>(
+          lms111::RecordedScanSource::fromFile(telegram));
+    } else {
+      simulation::Scene scene;
+      if (!scene_path.empty()) {
+        scene = simulation::loadScene(scene_path);
+      } else {
+        simulation::OrchardConfig orchard;
+        orchard.preset = preset;
+        scene = simulation::generateOrchard(orchard, seed).scene;
+      }
+      simulation::Lms111Config sensor;
+      sensor.range_noise_sigma = noise_mm / 1000.0;
+      const Eigen::Isometry3d pose = lms111::SimulatedScanSource::frontView(distance, height);
+      source = std::make_shared<lms111::SimulatedScanSource>(
+          scene, [pose](double) { return pose; }, sensor, seed);
+    }
+    auto emulated = std::make_shared<lms111::EmulatedLms111>(device, source, faults);
+    lms111::EmulatorServer running(emulated, server);
+    std::cout << "lms111_emulator: listening on " << server.address << ", CoLa-A port "
+              << running.colaAPort() << ", CoLa-B port " << running.colaBPort() << std::endl;
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    const auto start = std::chrono::steady_clock::now();
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (duration > 0 &&
+          std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
+        break;
+    }
+    running.stop();
+    std::cout << "lms111_emulator: " << running.connectionsAccepted() << " connections, "
+              << running.telegramsSent() << " scan telegrams sent" << std::endl;
+    return 0;
+  } catch (const po::error& e) {
+    std::cerr << "lms111_emulator: " << e.what() << "\n" << desc << "\n";
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << "lms111_emulator: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
+    return 3;
+  }
+}
