@@ -24,9 +24,15 @@ foreach(test_source ${DTM_ROSTEST_NODES})
   target_link_libraries(${test_name} dtm_ros ${GTEST_LIBRARIES})
   target_include_directories(${test_name} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
   target_compile_definitions(${test_name} PRIVATE
-    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}")
+    DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"
+    DTM_BIN_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
   add_dependencies(tests ${test_name})
 endforeach()
+
+# The driver's node test runs the emulator.
+if(TARGET test_lms111_driver_node)
+  add_dependencies(test_lms111_driver_node lms111_emulator lms111_driver)
+endif()
 
 file(GLOB DTM_ROSTESTS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.test)
 foreach(launch_file ${DTM_ROSTESTS})

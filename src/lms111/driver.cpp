@@ -218,9 +218,8 @@ class Lms111Driver::Session {
                         (result < 5 ? WHY[result] : "error " + std::to_string(result)));
       }
     } catch (const DeviceRefusal& e) {
-      d_.log(1, std::string(e.what()) +
-                    "; checking whether it already runs the asked "
-                    "configuration");
+      d_.log(1, std::string(e.what()) + "; checking whether it already runs the asked one");
+      verifyScanConfig();
     }
   }
 
@@ -434,9 +433,11 @@ void Lms111Driver::run() {
       session.connect();
       setState(DriverState::CONFIGURING);
       session.configure();
-      log(0, "LMS111 at " + where + " configured: " + std::to_string(config_.scan_frequency_hz) +
-                 " Hz, " + std::to_string(config_.angular_resolution_deg) + " deg, " +
-                 std::to_string(config_.beamCount()) + " beams");
+      std::ostringstream configured;
+      configured << "LMS111 at " << where << " (" << statistics().device_ident
+                 << ") configured: " << config_.scan_frequency_hz << " Hz, "
+                 << config_.angular_resolution_deg << " deg, " << config_.beamCount() << " beams";
+      log(0, configured.str());
       // A device that rebooted has a new clock; a mapping across connections is not trusted.
       clock_mapper_.reset();
       session.stream();

@@ -197,7 +197,9 @@ struct EmulatorServer::Impl {
       anyone = anyone || s->state.streaming;
     if (!anyone)
       return;
-    const auto telegram = device->nextScan(now());
+    // A real device's scans are exactly periodic: stamp with the schedule, not the wake-up.
+    const auto telegram =
+        device->nextScan(std::chrono::duration<double>(next_scan - start).count());
     if (!telegram)
       return;
     const EmulatorFaults& faults = device->faults();

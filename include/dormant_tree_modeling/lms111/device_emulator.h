@@ -102,7 +102,7 @@ class EmulatedLms111 {
   /// @brief `STlms` state at a time.
   int state(double now_s) const;
   /// @brief Seconds between two scans at the active configuration.
-  double scanPeriod() const { return 100.0 / config_.scan.frequency; }
+  double scanPeriod() const { return 100.0 / active_.frequency; }
   /// @brief The next scan telegram, its first ray at now_s; advances the counters. Empty
   /// when the device is not ready, or the output interval skips this scan.
   std::optional<ScanTelegram> nextScan(double now_s);
