@@ -12,7 +12,7 @@ CMAKE_ARGS := -DPYTHON_EXECUTABLE=$(PYTHON) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DC
 	-DCATKIN_DEVEL_PREFIX=$(BUILD)/devel
 SOURCES = $(shell cd $(ROOT) && git ls-files -co --exclude-standard -- '*.cpp' '*.h')
 
-.PHONY: all setup build test bench demo format format-check lint clean help
+.PHONY: all setup build test bench fuzz demo format format-check lint clean help
 
 all: build
 
@@ -21,6 +21,7 @@ help:
 	@echo "make build         build everything (BUILD_TYPE=$(BUILD_TYPE))"
 	@echo "make test          setup + build + every gtest and rostest; ends 'N passed, N failed'"
 	@echo "make bench         setup + build + benchmarks (timings, memory, accuracy tables)"
+	@echo "make fuzz          libFuzzer on the LMS111 parser and framers (FUZZ_SECONDS=60; installs clang)"
 	@echo "make demo          setup + build + a synthetic tree scanned, modeled and scored -> results/"
 	@echo "make format        clang-format the sources in place"
 	@echo "make format-check  fail on any badly formatted source; check the core has no ROS"
@@ -46,6 +47,9 @@ test: build
 bench: build
 	$(MAKE) -C $(BUILD)/cmake -j$(JOBS) benchmarks
 	bash scripts/run_benchmarks.sh $(BUILD)/devel/lib/dormant_tree_modeling
+
+fuzz:
+	bash scripts/fuzz.sh
 
 demo: build
 	bash scripts/demo.sh

@@ -3,13 +3,13 @@
 #include <benchmark/benchmark.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <sys/resource.h>
 
 #include <filesystem>
 
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
+#include "peak_memory.h"
 
 using namespace dormant_tree_modeling;
 
@@ -61,11 +61,9 @@ void BM_Model(benchmark::State& state) {
       break;
     }
   }
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
   state.counters["points"] = static_cast<double>(input.size());
   state.counters["branches"] = static_cast<double>(branches);
-  state.counters["peak_rss_MiB"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
+  bench::reportPeakMemory(state);
   state.SetLabel(ours ? "ours" : "paper");
 }
 BENCHMARK(BM_Model)

@@ -2,7 +2,6 @@
 // rays through a loop over every primitive (the baseline the BVH replaces), and one full view
 // (200 x 1080 beams, 7 rays per beam) on one core against the device's own 8 s / 4 s.
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
 
 #include <cmath>
 
@@ -10,6 +9,7 @@
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
+#include "peak_memory.h"
 
 using namespace dormant_tree_modeling;
 using namespace dormant_tree_modeling::simulation;
@@ -33,12 +33,6 @@ std::vector<Ray> laserRays(int n) {
   return rays;
 }
 
-void peakMemory(benchmark::State& state) {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  state.counters["peak_rss_MiB"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
 void BM_RayCastBvh(benchmark::State& state) {
   const RayCaster caster(orchard().scene);
   const auto rays = laserRays(20000);
@@ -50,7 +44,7 @@ void BM_RayCastBvh(benchmark::State& state) {
   benchmark::DoNotOptimize(hits);
   state.SetItemsProcessed(state.iterations() * rays.size());
   state.counters["primitives"] = static_cast<double>(caster.size());
-  peakMemory(state);
+  bench::reportPeakMemory(state);
 }
 BENCHMARK(BM_RayCastBvh)->Unit(benchmark::kMillisecond);
 
@@ -77,7 +71,7 @@ void BM_RayCastEveryPrimitive(benchmark::State& state) {
   }
   benchmark::DoNotOptimize(hits);
   state.SetItemsProcessed(state.iterations() * rays.size());
-  peakMemory(state);
+  bench::reportPeakMemory(state);
 }
 BENCHMARK(BM_RayCastEveryPrimitive)->Unit(benchmark::kMillisecond);
 
@@ -97,7 +91,7 @@ void BM_SimulateFullView(benchmark::State& state) {
   }
   state.counters["beams"] = sweep.linesPerView() * config.beamCount();
   state.counters["device_s"] = sweep.linesPerView() / config.scan_frequency_hz;
-  peakMemory(state);
+  bench::reportPeakMemory(state);
 }
 BENCHMARK(BM_SimulateFullView)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond)->Iterations(3);
 

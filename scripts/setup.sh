@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Installs the Debian packages of scripts/debian-packages.txt, skipping apt when all are
-# present. Works as root, or as a user with sudo. (The build itself goes to .build/, see the
+# Installs the Debian packages of a package list (default scripts/debian-packages.txt; `make
+# fuzz` passes scripts/debian-packages-fuzz.txt), skipping apt when all are present. Works as root, or as a user with sudo. (The build itself goes to .build/, see the
 # Makefile: a standalone catkin build of this package.)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
-mapfile -t packages < <(grep -v '^\s*#' "$root/scripts/debian-packages.txt" | awk 'NF {print $1}')
+list="${1:-$root/scripts/debian-packages.txt}"
+mapfile -t packages < <(grep -v '^\s*#' "$list" | awk 'NF {print $1}')
 missing=()
 for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)

@@ -298,7 +298,8 @@ std::string scanTelegramToJson(const ScanTelegram& s) {
                   {"time_us", s.event->time_us},
                   {"angle_deg", s.event->angle / 10000.0}};
   }
-  return j.dump(1) + "\n";
+  // Names come from the device: invalid UTF-8 is replaced, not a reason to throw.
+  return j.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace lms111

@@ -158,6 +158,15 @@ TEST(ScanTelegram, ColaBIsBinaryAndChecked) {
   EXPECT_THROW(encodeScanTelegram(bad, Protocol::COLA_B), Error);
 }
 
+TEST(ScanTelegram, JsonOfANameThatIsNotUtf8DoesNotThrow) {
+  // Found by the fuzzer (make fuzz): names are the device's bytes, not necessarily UTF-8.
+  ScanTelegram s = parseScanTelegram(realTelegram());
+  s.device_name = std::string("LMS\xFF\xFE", 5);
+  std::string json;
+  ASSERT_NO_THROW(json = scanTelegramToJson(s));
+  EXPECT_NE(json.find("device_name"), std::string::npos);
+}
+
 TEST(ScanTelegram, InconsistentTelegramsAreRejectedWithAReason) {
   const std::string real = realTelegram();
   EXPECT_EQ(parseCode(""), ErrorCode::PARSE_ERROR);
