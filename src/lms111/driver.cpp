@@ -5,9 +5,9 @@
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/tcp_connection.h"
 #include "dormant_tree_modeling/lms111/cola_fields.h"
 #include "dormant_tree_modeling/lms111/device_emulator.h"
-#include "dormant_tree_modeling/lms111/tcp_connection.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {

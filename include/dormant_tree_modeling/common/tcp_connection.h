@@ -4,10 +4,10 @@
 #include <string>
 
 namespace dormant_tree_modeling {
-namespace lms111 {
 
 /// @brief A blocking TCP client connection in which every operation has a deadline, so a
-/// driver thread can never hang on a dead device (Boost.Asio, kept out of this header).
+/// driver thread can never hang on a dead device (LMS111, Aerotech). Boost.Asio stays out of
+/// this header.
 class TcpConnection {
  public:
   TcpConnection();
@@ -33,5 +33,4 @@ class TcpConnection {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace lms111
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/lms111/tcp_connection.h"
+#include "dormant_tree_modeling/common/tcp_connection.h"
 
 #include <array>
 #include <boost/asio.hpp>
@@ -7,7 +7,6 @@
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
@@ -123,5 +122,4 @@ bool TcpConnection::isOpen() const {
   return impl_->socket.is_open();
 }
 
-}  // namespace lms111
 }  // namespace dormant_tree_modeling
