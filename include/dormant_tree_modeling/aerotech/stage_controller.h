@@ -1,0 +1,74 @@
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "dormant_tree_modeling/aerotech/ensemble_client.h"
+#include "dormant_tree_modeling/aerotech/stage_config.h"
+
+namespace dormant_tree_modeling {
+namespace aerotech {
+
+/// @brief A move as the `~move_axis` service asks for it (service units: deg or m).
+struct MoveRequest {
+  std::string axis;  ///< controller axis name or joint name
+  double target = 0;
+  double velocity = 0;  ///< 0: the axis's default
+  bool relative = false;
+  bool wait = true;
+};
+
+/// @brief What became of a move.
+struct MoveResult {
+  bool success = false;
+  std::string message;
+  double position = 0;  ///< feedback after the command, service units
+};
+
+/// @brief Feedback of both axes, sampled together.
+struct StageFeedback {
+  double rotary = 0;  ///< deg
+  double slide = 0;   ///< m
+};
+
+/// @brief Axis state for diagnostics.
+struct StageHealth {
+  AxisStatus rotary_status, slide_status;
+  std::uint32_t rotary_faults = 0, slide_faults = 0;
+};
+
+/// @brief The rotary stage and the slide behind one Ensemble: unit conversion, soft limits,
+/// moves that wait with a deadline derived from the distance, homing, and a second socket for
+/// feedback so that position sampling never waits behind a blocking HOME. ROS-free.
+class StageController {
+ public:
+  /// @throws Error INVALID_ARGUMENT for a bad configuration
+  explicit StageController(StageConfig config);
+
+  /// @brief Acknowledge faults, enable both axes, home them when configured.
+  /// @throws Error IO_FAILURE with the controller's reason
+  void setUp();
+  /// @brief Move one axis; failures (limits, faults, timeouts, lost connection) come back in
+  /// the result, decoded, never as an exception.
+  MoveResult move(const MoveRequest& request);
+  /// @brief Acknowledge faults, enable and home the rotary stage, then the slide.
+  MoveResult home();
+  /// @brief Both positions. @throws Error IO_FAILURE
+  StageFeedback feedback();
+  /// @brief Status and fault words of both axes. @throws Error IO_FAILURE
+  StageHealth health();
+  /// @brief Abort both axes (best effort; shutdown).
+  void stopAll();
+  /// @brief The axis configuration named by controller axis or joint name, or null.
+  const StageAxisConfig* axis(const std::string& name) const;
+  const StageConfig& config() const { return config_; }
+  /// @brief Reconnections of the command and feedback sockets so far.
+  std::uint64_t reconnects() const;
+
+ private:
+  StageConfig config_;
+  EnsembleClient command_, feedback_;
+};
+
+}  // namespace aerotech
+}  // namespace dormant_tree_modeling

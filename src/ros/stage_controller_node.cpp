@@ -1,0 +1,245 @@
+#include "dormant_tree_modeling/ros/stage_controller_node.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/JointState.h>
+
+#include <cmath>
+
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+constexpr double SETUP_RETRY_S = 2.0;
+constexpr double HEALTH_PERIOD_S = 1.0;
+
+Eigen::Vector3d vectorParam(ros::NodeHandle& pnh, const std::string& name) {
+  std::vector<double> v;
+  if (!pnh.getParam(name, v))
+    return Eigen::Vector3d::Zero();
+  if (v.size() != 3)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~" + name + " must be [x, y, z] in m");
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+void readAxis(ros::NodeHandle& pnh, const std::string& ns, aerotech::StageAxisConfig& a) {
+  a.axis = pnh.param(ns + "/axis", a.axis);
+  a.joint = pnh.param(ns + "/joint", a.joint);
+  a.scale = pnh.param(ns + "/scale", a.scale);
+  a.default_velocity = pnh.param(ns + "/default_velocity", a.default_velocity);
+  a.min_position = pnh.param(ns + "/min_position", a.min_position);
+  a.max_position = pnh.param(ns + "/max_position", a.max_position);
+}
+
+aerotech::StageConfig readConfig(ros::NodeHandle& pnh) {
+  aerotech::StageConfig c;
+  c.controller.host = pnh.param("host", c.controller.host);
+  c.controller.port = pnh.param("port", c.controller.port);
+  c.controller.connect_timeout_s = pnh.param("connect_timeout", c.controller.connect_timeout_s);
+  c.controller.reply_timeout_s = pnh.param("reply_timeout", c.controller.reply_timeout_s);
+  c.controller.home_timeout_s = pnh.param("home_timeout", c.controller.home_timeout_s);
+  readAxis(pnh, "rotary", c.rotary);
+  readAxis(pnh, "slide", c.slide);
+  c.geometry.platform_to_slide_base = vectorParam(pnh, "platform_to_slide_base");
+  c.geometry.carriage_to_stage = vectorParam(pnh, "carriage_to_stage");
+  c.geometry.stage_to_laser = vectorParam(pnh, "stage_to_laser");
+  c.joint_state_rate = pnh.param("joint_state_rate", c.joint_state_rate);
+  c.home_on_start = pnh.param("home_on_start", c.home_on_start);
+  c.move_timeout_margin_s = pnh.param("move_timeout_margin", c.move_timeout_margin_s);
+  c.validate();
+  return c;
+}
+
+geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
+                                          const Eigen::Vector3d& t, const Eigen::Quaterniond& q,
+                                          const ros::Time& stamp) {
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = stamp;
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = t.x();
+  m.transform.translation.y = t.y();
+  m.transform.translation.z = t.z();
+  m.transform.rotation.x = q.x();
+  m.transform.rotation.y = q.y();
+  m.transform.rotation.z = q.z();
+  m.transform.rotation.w = q.w();
+  return m;
+}
+
+}  // namespace
+
+StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  stage_ = std::make_unique<aerotech::StageController>(readConfig(pnh));
+  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
+  slide_base_frame_ = pnh.param<std::string>("slide_base_frame", "slide_base");
+  carriage_frame_ = pnh.param<std::string>("slide_carriage_frame", "slide_carriage");
+  stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
+  laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
+  joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 50);
+  move_srv_ = pnh.advertiseService("move_axis", &StageControllerNode::moveAxis, this);
+  home_srv_ = pnh.advertiseService("home", &StageControllerNode::home, this);
+  publishStaticFrames();
+  const auto& c = stage_->config().controller;
+  updater_.setHardwareID("Aerotech Ensemble " + c.host + ":" + std::to_string(c.port));
+  updater_.add("stage", this, &StageControllerNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  setup_thread_ = std::thread([this] { setUpLoop(); });
+  feedback_thread_ = std::thread([this] { feedbackLoop(); });
+}
+
+StageControllerNode::~StageControllerNode() {
+  stop_ = true;
+  if (setup_thread_.joinable())
+    setup_thread_.join();
+  if (feedback_thread_.joinable())
+    feedback_thread_.join();
+  stage_->stopAll();
+}
+
+void StageControllerNode::setUpLoop() {
+  while (!stop_ && !ready_) {
+    try {
+      stage_->setUp();
+      ready_ = true;
+      ROS_INFO("stage ready: axes %s and %s enabled%s", stage_->config().rotary.axis.c_str(),
+               stage_->config().slide.axis.c_str(),
+               stage_->config().home_on_start ? " and homed" : "");
+    } catch (const Error& e) {
+      {
+        std::lock_guard<std::mutex> lock(status_mutex_);
+        last_error_ = e.what();
+      }
+      ROS_ERROR_THROTTLE(10.0, "stage set-up failed: %s; retrying every %.0f s", e.what(),
+                         SETUP_RETRY_S);
+      for (int i = 0; i < 20 && !stop_; ++i)
+        ros::WallDuration(SETUP_RETRY_S / 20).sleep();
+    }
+  }
+}
+
+void StageControllerNode::feedbackLoop() {
+  const auto& c = stage_->config();
+  ros::WallRate rate(c.joint_state_rate);
+  ros::WallTime last_health(0.0), window_start = ros::WallTime::now();
+  int samples = 0;
+  while (!stop_ && ros::ok()) {
+    try {
+      const ros::Time before = ros::Time::now();
+      const aerotech::StageFeedback f = stage_->feedback();
+      const ros::Time after = ros::Time::now();
+      const ros::Time stamp = before + (after - before) * 0.5;
+      sensor_msgs::JointState js;
+      js.header.stamp = stamp;
+      js.name = {c.rotary.joint, c.slide.joint};
+      js.position = {f.rotary * DEG, f.slide};
+      joint_pub_.publish(js);
+      tf_.sendTransform(
+          {transform(slide_base_frame_, carriage_frame_, Eigen::Vector3d(0.0, f.slide, 0.0),
+                     Eigen::Quaterniond::Identity(), stamp),
+           transform(
+               stage_frame_, laser_frame_,
+               Eigen::AngleAxisd(f.rotary * DEG, Eigen::Vector3d::UnitZ()) *
+                   c.geometry.stage_to_laser,
+               // The LMS111 lies on its side: its scan plane is the stage's
+               // vertical plane at θ (LaserScan angle +90° points up).
+               Eigen::Quaterniond(Eigen::AngleAxisd(f.rotary * DEG, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX())),
+               stamp)});
+      ++samples;
+      const ros::WallTime now = ros::WallTime::now();
+      if ((now - last_health).toSec() > HEALTH_PERIOD_S) {
+        const aerotech::StageHealth h = stage_->health();
+        std::lock_guard<std::mutex> lock(status_mutex_);
+        health_ = h;
+        health_known_ = true;
+        feedback_rate_ = samples / std::max(1e-3, (now - window_start).toSec());
+        samples = 0;
+        window_start = now;
+        last_health = now;
+      }
+    } catch (const Error& e) {
+      {
+        std::lock_guard<std::mutex> lock(status_mutex_);
+        last_error_ = e.what();
+        health_known_ = false;
+      }
+      ROS_WARN_THROTTLE(5.0, "stage feedback: %s", e.what());
+      ros::WallDuration(0.2).sleep();
+    }
+    rate.sleep();
+  }
+}
+
+void StageControllerNode::publishStaticFrames() {
+  const auto& g = stage_->config().geometry;
+  const ros::Time now = ros::Time::now();
+  static_tf_.sendTransform({transform(platform_frame_, slide_base_frame_, g.platform_to_slide_base,
+                                      Eigen::Quaterniond::Identity(), now),
+                            transform(carriage_frame_, stage_frame_, g.carriage_to_stage,
+                                      Eigen::Quaterniond::Identity(), now)});
+}
+
+bool StageControllerNode::moveAxis(dormant_tree_modeling::MoveAxis::Request& req,
+                                   dormant_tree_modeling::MoveAxis::Response& res) {
+  if (!ready_) {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    res.success = false;
+    res.message = "stage not ready: " + (last_error_.empty() ? "setting up" : last_error_);
+    return true;
+  }
+  aerotech::MoveRequest q;
+  q.axis = req.axis;
+  q.target = req.target;
+  q.velocity = req.velocity;
+  q.relative = req.relative;
+  q.wait = req.wait;
+  const aerotech::MoveResult r = stage_->move(q);
+  res.success = r.success;
+  res.message = r.message;
+  res.position = r.position;
+  if (!r.success) {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    last_error_ = r.message;
+    ROS_ERROR("move_axis %s: %s", req.axis.c_str(), r.message.c_str());
+  }
+  return true;
+}
+
+bool StageControllerNode::home(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  const aerotech::MoveResult r = stage_->home();
+  res.success = r.success;
+  res.message = r.message;
+  return true;
+}
+
+void StageControllerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(status_mutex_);
+  const auto& c = stage_->config();
+  if (!health_known_) {
+    status.summaryf(DiagnosticStatus::ERROR, "no feedback: %s", last_error_.c_str());
+  } else if (health_.rotary_faults || health_.slide_faults) {
+    status.summaryf(DiagnosticStatus::ERROR, "axis fault: %s %s, %s %s", c.rotary.axis.c_str(),
+                    aerotech::describeFaults(health_.rotary_faults).c_str(), c.slide.axis.c_str(),
+                    aerotech::describeFaults(health_.slide_faults).c_str());
+  } else if (!ready_) {
+    status.summary(DiagnosticStatus::WARN, "setting up (enable, home)");
+  } else {
+    status.summary(DiagnosticStatus::OK, "ready");
+  }
+  status.add("rotary status", health_.rotary_status.describe());
+  status.add("slide status", health_.slide_status.describe());
+  status.add("rotary faults", aerotech::describeFaults(health_.rotary_faults));
+  status.add("slide faults", aerotech::describeFaults(health_.slide_faults));
+  status.add("joint state rate (Hz)", feedback_rate_);
+  status.add("reconnects", stage_->reconnects());
+  status.add("last error", last_error_);
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling
