@@ -20,6 +20,12 @@ double RangeImage::theta(int row) const {
   return theta0 + row * theta_step;
 }
 
+double RangeImage::theta(int row, int col) const {
+  const double rate =
+      static_cast<std::size_t>(row) < row_theta_rate.size() ? row_theta_rate[row] : 0.0;
+  return theta(row) + rate * col;
+}
+
 std::size_t RangeImage::validCount() const {
   std::size_t n = 0;
   for (const float r : range)
@@ -38,8 +44,8 @@ CloudPtr toCloud(const RangeImage& image, double phi_min, double phi_max) {
   auto cloud = std::make_shared<Cloud>();
   cloud->reserve(image.validCount());
   for (int i = 0; i < image.rows; ++i) {
-    const double theta = image.theta(i);
     for (int j = 0; j < image.cols; ++j) {
+      const double theta = image.theta(i, j);
       const float rho = image.at(i, j);
       const double phi = image.phi(j);
       if (!(rho > 0.0f) || phi < phi_min || phi >= phi_max)

@@ -21,13 +21,18 @@ struct RangeImage {
   std::vector<float> range;        ///< m, row-major, 0 = invalid
   std::vector<std::uint8_t> rssi;  ///< optional, same layout (empty when unknown)
   std::vector<double> row_theta;  ///< optional measured theta per row (rad); empty: theta0 + i*step
+  /// Optional, per row: how theta changes along the row (rad per column), for a stage that
+  /// turns while the line is measured (a continuous sweep). Empty: constant along a row.
+  std::vector<double> row_theta_rate;
 
   /// @brief Allocate rows x cols invalid pixels.
   void resize(int r, int c);
   float& at(int row, int col) { return range[static_cast<std::size_t>(row) * cols + col]; }
   float at(int row, int col) const { return range[static_cast<std::size_t>(row) * cols + col]; }
-  /// @brief Theta of a row: the measured one when known.
+  /// @brief Theta of a row (at column 0): the measured one when known.
   double theta(int row) const;
+  /// @brief Theta of one pixel: the row's, moved on by the row's rate when known.
+  double theta(int row, int col) const;
   /// @brief Phi of a column.
   double phi(int col) const { return phi0 + col * phi_step; }
   /// @brief Number of valid pixels.

@@ -1,0 +1,208 @@
+#include "dormant_tree_modeling/acquisition/target_isolation.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace acquisition {
+
+namespace {
+
+struct CellKey {
+  std::int64_t x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct CellHash {
+  std::size_t operator()(const CellKey& k) const {
+    return static_cast<std::size_t>(k.x * 73856093) ^ static_cast<std::size_t>(k.y * 19349663) ^
+           static_cast<std::size_t>(k.z * 83492791);
+  }
+};
+
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+// Ground level: the most populated 2 cm height bin among the lowest metre of points, if it
+// holds enough of the cloud.
+bool groundLevel(const Cloud& cloud, const IsolationConfig& c, double& z) {
+  float lowest = INFINITY;
+  for (const auto& p : cloud)
+    lowest = std::min(lowest, p.z);
+  constexpr double BIN = 0.02;
+  std::map<int, std::size_t> bins;
+  for (const auto& p : cloud) {
+    if (p.z < lowest + 1.0)
+      ++bins[static_cast<int>((p.z - lowest) / BIN)];
+  }
+  const auto best = std::max_element(
+      bins.begin(), bins.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  if (best == bins.end() || best->second < c.ground_min_fraction * cloud.size())
+    return false;
+  z = lowest + (best->first + 1) * BIN;  // the top of the ground bin
+  return true;
+}
+
+}  // namespace
+
+void IsolationConfig::validate() const {
+  auto require = [](bool ok, const char* m) {
+    if (!ok)
+      throw Error(ErrorCode::INVALID_ARGUMENT, std::string("target isolation: ") + m);
+  };
+  require(ground_margin >= 0 && ground_min_fraction >= 0 && ground_min_fraction < 1,
+          "ground_margin >= 0 and 0 <= ground_min_fraction < 1");
+  require(trunk_band_low < trunk_band_high, "trunk_band_low < trunk_band_high");
+  require(cell > 0 && component_cell > 0, "cell sizes must be > 0");
+  require(hint_sigma > 0, "hint_sigma must be > 0");
+  require(min_distance >= 0 && max_distance > min_distance, "0 <= min_distance < max_distance");
+  require(crop_radius > 0 && max_height > 0, "crop_radius and max_height must be > 0");
+  require(trunk_clearance > 0 && other_column_radius > 0,
+          "trunk_clearance and other_column_radius must be > 0");
+}
+
+IsolationResult isolateTarget(const Cloud& cloud, const Eigen::Vector3d& sensor,
+                              const Eigen::Vector3d& forward_in, const Eigen::Vector2d& hint,
+                              const IsolationConfig& c) {
+  c.validate();
+  if (cloud.empty())
+    throw Error(ErrorCode::EMPTY_INPUT, "target isolation: the view is empty");
+  Eigen::Vector2d forward(forward_in.x(), forward_in.y());
+  if (forward.norm() < 1e-9)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "target isolation: forward must be horizontal");
+  forward.normalize();
+  IsolationResult out;
+  out.ground_found = groundLevel(cloud, c, out.ground_z);
+  const double base = out.ground_found ? out.ground_z : -INFINITY;
+
+  // Trunk: the best-scoring column of the band, counts smoothed over 3 x 3 cells.
+  std::unordered_map<std::int64_t, std::size_t> counts;
+  auto key = [&](double x, double y) {
+    return (static_cast<std::int64_t>(std::floor(x / c.cell)) << 32) ^
+           (static_cast<std::int64_t>(std::floor(y / c.cell)) & 0xffffffff);
+  };
+  auto inBand = [&](const Point& p) {
+    return !out.ground_found || (p.z >= base + c.trunk_band_low && p.z <= base + c.trunk_band_high);
+  };
+  for (const auto& p : cloud) {
+    if (inBand(p))
+      ++counts[key(p.x, p.y)];
+  }
+  double best_score = 0.0;
+  for (const auto& [k, n] : counts) {
+    const double cx = (static_cast<double>(k >> 32) + 0.5) * c.cell;
+    const double cy =
+        (static_cast<double>(static_cast<std::int32_t>(k & 0xffffffff)) + 0.5) * c.cell;
+    const Eigen::Vector2d d = Eigen::Vector2d(cx, cy) - sensor.head<2>();
+    const double ahead = d.dot(forward);
+    if (ahead < c.min_distance || ahead > c.max_distance)
+      continue;
+    const double off = (Eigen::Vector2d(cx, cy) - hint).norm();
+    std::size_t sum = 0;
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        const auto it = counts.find(key(cx + dx * c.cell, cy + dy * c.cell));
+        sum += it == counts.end() ? 0 : it->second;
+      }
+    }
+    const double score = sum * std::exp(-0.5 * std::pow(off / c.hint_sigma, 2));
+    if (score > best_score) {
+      best_score = score;
+      out.trunk = Eigen::Vector2d(cx, cy);
+    }
+  }
+  if (best_score == 0.0)
+    throw Error(ErrorCode::EMPTY_INPUT, "target isolation: no tree ahead of the sensor");
+
+  // Other upright objects near the trunk (trellis posts, a neighbour's trunk): columns whose
+  // points fill most of the band's height, away from the trunk. Branches cross the band;
+  // they do not fill it.
+  std::vector<Eigen::Vector2d> others;
+  if (out.ground_found) {
+    constexpr double BIN = 0.1;
+    const int bins = std::max(1, static_cast<int>((c.trunk_band_high - c.trunk_band_low) / BIN));
+    std::unordered_map<std::int64_t, std::uint32_t> filled;
+    for (const auto& p : cloud) {
+      if (!inBand(p))
+        continue;
+      const int b = std::min(bins - 1, static_cast<int>((p.z - base - c.trunk_band_low) / BIN));
+      filled[key(p.x, p.y)] |= 1u << b;
+    }
+    for (const auto& [k, mask] : filled) {
+      const Eigen::Vector2d centre(
+          (static_cast<double>(k >> 32) + 0.5) * c.cell,
+          (static_cast<double>(static_cast<std::int32_t>(k & 0xffffffff)) + 0.5) * c.cell);
+      if (__builtin_popcount(mask) >= 0.7 * bins && (centre - out.trunk).norm() > c.trunk_clearance)
+        others.push_back(centre);
+    }
+  }
+
+  // Crop.
+  std::vector<Point> kept;
+  for (const auto& p : cloud) {
+    if (out.ground_found && p.z < base + c.ground_margin) {
+      ++out.ground_removed;
+      continue;
+    }
+    const Eigen::Vector2d xy(p.x, p.y);
+    const double r = (xy - out.trunk).norm();
+    bool other = false;
+    for (const auto& o : others)
+      other = other || (xy - o).norm() < c.other_column_radius;
+    if (r > c.crop_radius || other || (out.ground_found && p.z > base + c.max_height)) {
+      ++out.outside_removed;
+      continue;
+    }
+    kept.push_back(p);
+  }
+
+  // Small isolated components, by union-find over occupied cells (26-connected).
+  std::unordered_map<CellKey, int, CellHash> cell_index;
+  std::vector<int> point_cell(kept.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const CellKey k{static_cast<std::int64_t>(std::floor(kept[i].x / c.component_cell)),
+                    static_cast<std::int64_t>(std::floor(kept[i].y / c.component_cell)),
+                    static_cast<std::int64_t>(std::floor(kept[i].z / c.component_cell))};
+    const auto [it, added] = cell_index.emplace(k, static_cast<int>(cell_index.size()));
+    point_cell[i] = it->second;
+  }
+  std::vector<int> parent(cell_index.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [k, i] : cell_index) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cell_index.find({k.x + dx, k.y + dy, k.z + dz});
+          if (it != cell_index.end())
+            parent[findRoot(parent, i)] = findRoot(parent, it->second);
+        }
+      }
+    }
+  }
+  std::vector<std::size_t> size(parent.size(), 0);
+  for (std::size_t i = 0; i < kept.size(); ++i)
+    ++size[findRoot(parent, point_cell[i])];
+  out.cloud = std::make_shared<Cloud>();
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (size[findRoot(parent, point_cell[i])] >= c.min_component_points)
+      out.cloud->push_back(kept[i]);
+    else
+      ++out.small_component_points;
+  }
+  return out;
+}
+
+}  // namespace acquisition
+}  // namespace dormant_tree_modeling
