@@ -1,0 +1,65 @@
+#pragma once
+
+#include <ros/ros.h>
+#include <sensor_msgs/JointState.h>
+#include <sensor_msgs/LaserScan.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <deque>
+#include <mutex>
+
+#include "dormant_tree_modeling/acquisition/sweep_assembler.h"
+#include "dormant_tree_modeling/acquisition/view_processing.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+/// @brief ROS wrapper of the scan assembler: one rotary sweep -> one view.
+///
+/// Subscribes `scan` (LaserScan of the LMS111 driver) and `joint_states` (the stage's); service
+/// `~acquire_view` (std_srvs/Trigger) runs a sweep through the stage's `move_axis` service,
+/// either continuous (the stage turns at one θ step per scan period while the laser streams:
+/// 8 s at 25 Hz) or step-and-scan (`~mode: step`, the paper's: move, settle, take one line),
+/// gives every beam the θ interpolated from the stamped stage positions, applies Eq. 1,
+/// converts to the platform frame (tf) and isolates the target tree. Publishes `view_cloud`
+/// (PointCloud2 in the platform frame, stamped at the sweep's middle, so the platform's pose
+/// at that time in tf is the view's pose guess) and `range_image` (sensor_msgs/Image 32FC1,
+/// m, a row per line). Parameters in config/scan_assembler.yaml.
+class ScanAssemblerNode {
+ public:
+  /// @throws Error INVALID_ARGUMENT for a bad parameter
+  ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+ private:
+  void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
+  void jointCallback(const sensor_msgs::JointStateConstPtr& msg);
+  bool acquireView(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  /// Runs the sweep; returns a summary or throws Error.
+  std::string acquire();
+  void moveRotary(double target_deg, double velocity_deg_s);
+  std::vector<acquisition::SweepLine> linesBetween(double t0, double t1);
+  double lastScanPeriod();
+
+  std::string mode_, rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_;
+  double theta_min_deg_, theta_max_deg_, theta_step_deg_, sweep_margin_deg_, tree_distance_;
+  double settle_s_, buffer_s_;
+  acquisition::ViewProcessingConfig processing_;
+
+  ros::NodeHandle nh_;
+  ros::Subscriber scan_sub_, joint_sub_;
+  ros::Publisher cloud_pub_, image_pub_;
+  ros::ServiceServer acquire_srv_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+
+  std::mutex mutex_;  // the buffers below
+  std::deque<acquisition::SweepLine> lines_;
+  acquisition::StagePositionHistory history_;
+  double last_period_ = 0.0;
+  std::mutex acquire_mutex_;  // one sweep at a time
+};
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

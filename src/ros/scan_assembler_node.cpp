@@ -1,0 +1,227 @@
+#include "dormant_tree_modeling/ros/scan_assembler_node.h"
+
+#include <dormant_tree_modeling/MoveAxis.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/ros/conversions.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+// The LaserScan's angles are the device's minus 90 deg (hardware.md).
+constexpr double ROS_TO_DEVICE_ANGLE = M_PI / 2;
+
+}  // namespace
+
+ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+    : nh_(nh), tf_listener_(tf_buffer_), history_(0.1) {
+  mode_ = pnh.param<std::string>("mode", "continuous");
+  if (mode_ != "continuous" && mode_ != "step")
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode_);
+  rotary_axis_ = pnh.param<std::string>("rotary_axis", "X");
+  rotary_joint_ = pnh.param<std::string>("rotary_joint", "rotary_stage_joint");
+  move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
+  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
+  stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
+  theta_min_deg_ = pnh.param("theta_min", -45.0);
+  theta_max_deg_ = pnh.param("theta_max", 45.0);
+  theta_step_deg_ = pnh.param("theta_step", 0.45);
+  sweep_margin_deg_ = pnh.param("sweep_margin", 2.0);
+  tree_distance_ = pnh.param("tree_distance", 1.5);
+  settle_s_ = pnh.param("settle_time", 0.02);
+  buffer_s_ = pnh.param("buffer_seconds", 60.0);
+  if (!(theta_min_deg_ < theta_max_deg_ && theta_step_deg_ > 0 && sweep_margin_deg_ >= 0 &&
+        tree_distance_ > 0 && settle_s_ >= 0 && buffer_s_ > 10)) {
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "need theta_min < theta_max, theta_step > 0, sweep_margin >= 0, tree_distance > "
+                "0, settle_time >= 0, buffer_seconds > 10");
+  }
+  auto& p = processing_;
+  p.floating_threshold = pnh.param("floating_threshold", p.floating_threshold);
+  p.smoothing_iterations = pnh.param("smoothing_iterations", p.smoothing_iterations);
+  p.isolate = pnh.param("isolate", p.isolate);
+  p.isolation.crop_radius = pnh.param("crop_radius", p.isolation.crop_radius);
+  p.isolation.hint_sigma = pnh.param("hint_sigma", p.isolation.hint_sigma);
+  p.isolation.max_height = pnh.param("max_height", p.isolation.max_height);
+  p.validate();
+
+  scan_sub_ = nh.subscribe("scan", 200, &ScanAssemblerNode::scanCallback, this);
+  joint_sub_ = nh.subscribe("joint_states", 500, &ScanAssemblerNode::jointCallback, this);
+  cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 2, true);
+  image_pub_ = nh.advertise<sensor_msgs::Image>("range_image", 2, true);
+  acquire_srv_ = pnh.advertiseService("acquire_view", &ScanAssemblerNode::acquireView, this);
+}
+
+void ScanAssemblerNode::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
+  acquisition::SweepLine l;
+  l.stamp = msg->header.stamp.toSec();
+  l.time_increment = msg->time_increment;
+  l.phi0 = msg->angle_min + ROS_TO_DEVICE_ANGLE;
+  l.phi_step = msg->angle_increment;
+  l.ranges = msg->ranges;
+  l.intensities = msg->intensities;
+  std::lock_guard<std::mutex> lock(mutex_);
+  last_period_ = msg->scan_time;
+  lines_.push_back(std::move(l));
+  while (!lines_.empty() && lines_.back().stamp - lines_.front().stamp > buffer_s_)
+    lines_.pop_front();
+}
+
+void ScanAssemblerNode::jointCallback(const sensor_msgs::JointStateConstPtr& msg) {
+  for (std::size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i) {
+    if (msg->name[i] == rotary_joint_) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      history_.add(msg->header.stamp.toSec(), msg->position[i]);
+    }
+  }
+}
+
+double ScanAssemblerNode::lastScanPeriod() {
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(3.0);
+  while (ros::WallTime::now() < give_up) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (last_period_ > 0 && !lines_.empty() &&
+          ros::Time::now().toSec() - lines_.back().stamp < 1.0)
+        return last_period_;
+    }
+    ros::WallDuration(0.05).sleep();
+  }
+  throw Error(ErrorCode::IO_FAILURE, "no scans from the laser on " + scan_sub_.getTopic() +
+                                         " (is the LMS111 driver streaming?)");
+}
+
+void ScanAssemblerNode::moveRotary(double target_deg, double velocity_deg_s) {
+  dormant_tree_modeling::MoveAxis m;
+  m.request.axis = rotary_axis_;
+  m.request.target = target_deg;
+  m.request.velocity = velocity_deg_s;
+  m.request.wait = true;
+  if (!ros::service::call(move_service_, m))
+    throw Error(ErrorCode::IO_FAILURE, "the stage service " + move_service_ + " is not available");
+  if (!m.response.success) {
+    throw Error(ErrorCode::IO_FAILURE, "the rotary stage did not reach " +
+                                           std::to_string(target_deg) +
+                                           " deg: " + m.response.message);
+  }
+}
+
+std::vector<acquisition::SweepLine> ScanAssemblerNode::linesBetween(double t0, double t1) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<acquisition::SweepLine> out;
+  for (const auto& l : lines_) {
+    if (l.stamp >= t0 && l.stamp <= t1)
+      out.push_back(l);
+  }
+  return out;
+}
+
+std::string ScanAssemblerNode::acquire() {
+  const double period = lastScanPeriod();
+  const ros::WallTime started = ros::WallTime::now();
+  std::vector<acquisition::SweepLine> lines;
+  if (mode_ == "continuous") {
+    // One θ step per scan period; the margins let the stage reach speed before θ_min.
+    moveRotary(theta_min_deg_ - sweep_margin_deg_, 0.0);
+    const double t0 = ros::Time::now().toSec();
+    moveRotary(theta_max_deg_ + sweep_margin_deg_, theta_step_deg_ / period);
+    lines = linesBetween(t0, ros::Time::now().toSec());
+  } else {
+    const int steps =
+        static_cast<int>(std::ceil((theta_max_deg_ - theta_min_deg_) / theta_step_deg_ - 1e-9));
+    for (int k = 0; k < steps; ++k) {
+      moveRotary(theta_min_deg_ + k * theta_step_deg_, 0.0);
+      const double settled = ros::Time::now().toSec() + settle_s_;
+      // The first line that starts after the stage settled.
+      const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(5 * period + 1.0);
+      bool got = false;
+      while (!got && ros::WallTime::now() < give_up) {
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          for (const auto& l : lines_) {
+            if (l.stamp > settled) {
+              lines.push_back(l);
+              got = true;
+              break;
+            }
+          }
+        }
+        if (!got)
+          ros::WallDuration(0.002).sleep();
+      }
+      if (!got)
+        throw Error(ErrorCode::IO_FAILURE, "no scan line at step " + std::to_string(k));
+    }
+  }
+  ros::WallDuration(0.1).sleep();  // the last joint states of the sweep
+  acquisition::RangeImage image;
+  std::size_t dropped = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    image = acquisition::assembleRangeImage(lines, history_, theta_min_deg_ * DEG,
+                                            theta_max_deg_ * DEG, &dropped);
+  }
+  if (image.rows == 0) {
+    throw Error(ErrorCode::EMPTY_INPUT, "no scan line of the sweep had stage positions (" +
+                                            std::to_string(dropped) + " lines dropped)");
+  }
+  const double mid = lines[lines.size() / 2].stamp;
+  const auto stamp = ros::Time(mid);
+  Eigen::Isometry3d stage_in_platform;
+  try {
+    stage_in_platform = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(platform_frame_, stage_frame_, stamp, ros::Duration(1.0)));
+  } catch (const tf2::TransformException& e) {
+    throw Error(ErrorCode::IO_FAILURE, std::string("no transform ") + platform_frame_ + " <- " +
+                                           stage_frame_ + ": " + e.what());
+  }
+  sensor_msgs::Image img;
+  img.header.stamp = stamp;
+  img.header.frame_id = stage_frame_;
+  img.height = image.rows;
+  img.width = image.cols;
+  img.encoding = "32FC1";
+  img.step = image.cols * sizeof(float);
+  img.data.resize(image.range.size() * sizeof(float));
+  std::memcpy(img.data.data(), image.range.data(), img.data.size());
+  image_pub_.publish(img);
+
+  // The plan puts the trunk tree_distance ahead of the platform, on its axis.
+  const acquisition::ProcessedView view = acquisition::processView(
+      image, stage_in_platform, Eigen::Vector2d(tree_distance_, 0.0), processing_);
+  cloud_pub_.publish(toMsg(*view.cloud, platform_frame_, stamp));
+  std::ostringstream m;
+  m << image.rows << " x " << image.cols << " range image (" << dropped
+    << " lines without stage positions), " << view.floating_removed << " floating pixels removed, "
+    << view.cloud->size() << " points in the view in " << (ros::WallTime::now() - started).toSec()
+    << " s";
+  return m.str();
+}
+
+bool ScanAssemblerNode::acquireView(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> one(acquire_mutex_);
+  try {
+    res.message = acquire();
+    res.success = true;
+    ROS_INFO("view acquired: %s", res.message.c_str());
+  } catch (const Error& e) {
+    res.success = false;
+    res.message = e.what();
+    ROS_ERROR("acquire_view failed: %s", e.what());
+  }
+  return true;
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

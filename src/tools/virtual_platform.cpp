@@ -1,0 +1,144 @@
+// virtual_platform: the scanning platform without hardware. Serves an LMS111 (CoLa-A and
+// CoLa-B) and an Aerotech Ensemble (rotary stage X in deg, slide Y in mm) on 127.0.0.1 from
+// one synthetic orchard: the laser scans from the pose the emulated stage is in, so the
+// driver, stage controller and scan assembler run unchanged against it.
+#include <boost/program_options.hpp>
+#include <chrono>
+#include <csignal>
+#include <iostream>
+#include <thread>
+
+#include "command_line.h"
+#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
+#include "dormant_tree_modeling/aerotech/ensemble_server.h"
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/emulator_server.h"
+#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+#include "dormant_tree_modeling/simulation/orchard_generator.h"
+
+namespace po = boost::program_options;
+using namespace dormant_tree_modeling;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+void onSignal(int) {
+  g_stop = 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  lms111::EmulatorServerOptions lms;
+  int aerotech_port = 8000;
+  std::string scene_path, preset = "young_tall_spindle";
+  std::uint64_t seed = 1;
+  double noise_mm = 12.0, frequency = 25.0, duration = 0.0;
+  std::vector<double> platform = {0.0, -1.5, 1.5, 90.0};
+  aerotech::EnsembleFaults faults;
+  po::options_description desc(
+      "Usage: virtual_platform [options]\n"
+      "Serves an emulated LMS111 and Aerotech Ensemble on 127.0.0.1 until SIGINT/SIGTERM: the "
+      "laser scans a synthetic orchard from the pose of the emulated rotary stage (X, deg) and "
+      "slide (Y, mm) on a platform at --platform.");
+  desc.add_options()("help,h", "this help")(
+      "lms-port", po::value(&lms.cola_a_port)->default_value(lms.cola_a_port),
+      "LMS111 CoLa-A port (0: any, -1: off)")(
+      "lms-b-port", po::value(&lms.cola_b_port)->default_value(lms.cola_b_port),
+      "LMS111 CoLa-B port (0: any, -1: off)")(
+      "aerotech-port", po::value(&aerotech_port)->default_value(aerotech_port), "Ensemble port")(
+      "scene", po::value(&scene_path), "scan this scene (scene.json of synth_tree)")(
+      "preset", po::value(&preset)->default_value(preset), "synthetic orchard preset")(
+      "seed", po::value(&seed)->default_value(seed), "synthetic orchard seed")(
+      "noise-mm", po::value(&noise_mm)->default_value(noise_mm), "range noise, 1 sigma, mm")(
+      "frequency", po::value(&frequency)->default_value(frequency),
+      "LMS111 power-up frequency, Hz (25 or 50)")(
+      "platform", po::value(&platform)->multitoken(),
+      "platform pose in the tree frame: x y z yaw_deg (default 0 -1.5 1.5 90: in front of the "
+      "tree, facing it, laser at 1.5 m)")("fault-axis", po::value(&faults.fault_axis),
+                                          "fault: this stage axis faults ...")(
+      "fault-on-move", po::value(&faults.fault_on_move), "... half-way through its N-th move")(
+      "duration", po::value(&duration)->default_value(duration), "seconds to run, 0 = forever");
+  try {
+    std::vector<char*> args;
+    for (int i = 0; i < argc; ++i) {
+      if (i == 0 || std::string(argv[i]).find(":=") == std::string::npos)
+        args.push_back(argv[i]);  // roslaunch's __name:= and remappings are not ours
+    }
+    po::variables_map vm;
+    if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
+      return 0;
+    if (platform.size() != 4)
+      throw Error(ErrorCode::INVALID_ARGUMENT, "--platform takes x y z yaw_deg");
+    if (frequency != 25.0 && frequency != 50.0)
+      throw Error(ErrorCode::INVALID_ARGUMENT, "--frequency must be 25 or 50");
+
+    aerotech::EmulatedAxisConfig rotary, slide;
+    rotary.name = "X";
+    rotary.max_velocity = 180.0;
+    rotary.acceleration = 720.0;
+    rotary.home_velocity = 90.0;
+    rotary.min_limit = -360.0;
+    rotary.max_limit = 360.0;
+    slide.name = "Y";
+    slide.max_velocity = 200.0;
+    slide.acceleration = 1000.0;
+    slide.home_velocity = 200.0;
+    slide.min_limit = -5.0;
+    slide.max_limit = 605.0;
+    auto ensemble = std::make_shared<aerotech::EmulatedEnsemble>(
+        std::vector<aerotech::EmulatedAxisConfig>{rotary, slide}, faults);
+    aerotech::EnsembleServer stage(ensemble, "127.0.0.1", aerotech_port);
+
+    simulation::Scene scene;
+    if (!scene_path.empty()) {
+      scene = simulation::loadScene(scene_path);
+    } else {
+      simulation::OrchardConfig orchard;
+      orchard.preset = preset;
+      scene = simulation::generateOrchard(orchard, seed).scene;
+    }
+    simulation::Lms111Config sensor;
+    sensor.range_noise_sigma = noise_mm / 1000.0;
+    const Eigen::Isometry3d platform_pose =
+        acquisition::platformPose(platform[0], platform[1], platform[2], platform[3] * M_PI / 180);
+    const acquisition::StageGeometry geometry;
+    const double period = 1.0 / frequency;
+    // A simulated line is taken from one pose: the stage's at the line's middle beam (135 of
+    // the mirror's 360 deg after the first ray), where the tree is.
+    auto pose = [&, period](double) {
+      const double t = stage.now() + 0.375 * period;
+      const double theta = ensemble->position("X", t) * M_PI / 180.0;
+      const double slide_m = ensemble->position("Y", t) / 1000.0;
+      return acquisition::laserPose(acquisition::stagePose(platform_pose, geometry, slide_m),
+                                    geometry, theta);
+    };
+    auto source = std::make_shared<lms111::SimulatedScanSource>(scene, pose, sensor, seed);
+    lms111::EmulatorConfig device;
+    device.scan.frequency = device.scan.resolution = frequency == 25.0 ? 2500 : 5000;
+    auto laser = std::make_shared<lms111::EmulatedLms111>(device, source);
+    lms111::EmulatorServer laser_server(laser, lms);
+    std::cout << "virtual_platform: LMS111 on 127.0.0.1:" << laser_server.colaAPort()
+              << " (CoLa-A), " << laser_server.colaBPort()
+              << " (CoLa-B); Aerotech on 127.0.0.1:" << stage.port() << std::endl;
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    const auto start = std::chrono::steady_clock::now();
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (duration > 0 &&
+          std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
+        break;
+    }
+    laser_server.stop();
+    stage.stop();
+    return 0;
+  } catch (const po::error& e) {
+    std::cerr << "virtual_platform: " << e.what() << "\n" << desc << "\n";
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << "virtual_platform: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
+    return 3;
+  }
+}
