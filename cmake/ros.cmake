@@ -1,8 +1,10 @@
 # The ROS layer: node classes (src/ros) in one library, one thin main per node (src/nodes).
 file(GLOB DTM_ROS_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/ros/*.cpp)
 add_library(dtm_ros ${DTM_ROS_SOURCES})
-target_include_directories(dtm_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
-target_link_libraries(dtm_ros PUBLIC dtm_core ${catkin_LIBRARIES})
+target_include_directories(dtm_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS}
+                           ${DTM_ROSBAG_INCLUDE_DIRS})
+target_link_libraries(dtm_ros PUBLIC dtm_core ${catkin_LIBRARIES} ${ROSBAG_LIBRARY}
+                      ${ROSBAG_STORAGE_LIBRARY} ${TOPIC_TOOLS_LIBRARY})
 add_dependencies(dtm_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})
 
 file(GLOB DTM_NODE_SOURCES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/nodes/*_node.cpp)

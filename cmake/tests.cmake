@@ -33,6 +33,10 @@ endforeach()
 if(TARGET test_lms111_driver_node)
   add_dependencies(test_lms111_driver_node lms111_emulator lms111_driver)
 endif()
+if(TARGET test_acquisition_node)
+  add_dependencies(test_acquisition_node virtual_platform lms111_driver stage_controller
+                   scan_assembler acquisition)
+endif()
 if(TARGET test_view_acquisition)
   add_dependencies(test_view_acquisition virtual_platform lms111_driver stage_controller
                    scan_assembler)

@@ -103,7 +103,9 @@ int main(int argc, char** argv) {
     sensor.range_noise_sigma = noise_mm / 1000.0;
     const Eigen::Isometry3d platform_pose =
         acquisition::platformPose(platform[0], platform[1], platform[2], platform[3] * M_PI / 180);
-    const acquisition::StageGeometry geometry;
+    // As config/stage_controller.yaml mounts it: the platform frame at the slide's centre.
+    acquisition::StageGeometry geometry;
+    geometry.platform_to_slide_base = Eigen::Vector3d(0.0, -0.3, 0.0);
     const double period = 1.0 / frequency;
     // A simulated line is taken from one pose: the stage's at the line's middle beam (135 of
     // the mirror's 360 deg after the first ray), where the tree is.

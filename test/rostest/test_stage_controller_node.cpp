@@ -90,10 +90,10 @@ TEST(StageControllerNode, MovesReportsFaultsAndPublishesStateAndTf) {
   ros::WallDuration(0.2).sleep();
   EXPECT_NEAR(rec.last().position.at(0), 30.0 * M_PI / 180.0, 1e-6);
 
-  // tf: the laser 0.1 m along the stage's rotated x... here on its axis, raised 0.1 m; the
-  // slide was homed back to 0 by ~home.
+  // tf: the laser on the stage's axis, raised 0.1 m; the slide, homed back to 0 by ~home, is
+  // 0.3 m to the right of the platform frame (config: the platform frame at the slide's centre).
   const auto t = tf_buffer.lookupTransform("platform", "laser", ros::Time(0), ros::Duration(2.0));
-  EXPECT_NEAR(t.transform.translation.y, 0.0, 1e-6);
+  EXPECT_NEAR(t.transform.translation.y, -0.3, 1e-6);
   EXPECT_NEAR(t.transform.translation.z, 0.1, 1e-6);
   // Rotation: yaw 30 deg then the LMS111 on its side (roll 90 deg).
   const double w = t.transform.rotation.w, x = t.transform.rotation.x, y = t.transform.rotation.y,

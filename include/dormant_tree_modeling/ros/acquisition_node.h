@@ -1,0 +1,69 @@
+#pragma once
+
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <topic_tools/shape_shifter.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include "dormant_tree_modeling/acquisition/sequencer.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+/// @brief The acquisition sequencer: runs the view plan of Algorithm 1 (config/view_plan.yaml)
+/// through the stage's `move_axis` (slide) and the assembler's `acquire_view`, asks the
+/// operator to move the platform (`~prompt`, std_msgs/String, latched; answered with
+/// `~platform_in_place`, std_srvs/Trigger, by the rviz user or a script), publishes the plan's
+/// platform pose as the tf `orchard -> platform` guess, shows progress on `~progress`
+/// (std_msgs/String: views done, failed, time left), and records the raw topics of the tree into
+/// one rosbag (`~output_dir`/`~tree_name`.bag) with a Markdown report beside it. Services
+/// `~start` and `~cancel`; a cancelled or interrupted run closes the bag, so it stays usable.
+class AcquisitionNode {
+ public:
+  /// @throws Error for a bad parameter or plan file
+  AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~AcquisitionNode();
+  AcquisitionNode(const AcquisitionNode&) = delete;
+  AcquisitionNode& operator=(const AcquisitionNode&) = delete;
+
+ private:
+  bool start(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool cancel(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool platformInPlace(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  void run();
+  bool askForPlatform(const acquisition::PlannedView& view);
+  void record(const std::string& topic, const topic_tools::ShapeShifter::ConstPtr& msg);
+  void publish(ros::Publisher& pub, const std::string& text);
+
+  ros::NodeHandle nh_;
+  acquisition::ViewPlanConfig plan_;
+  std::string output_dir_, tree_name_, move_service_, acquire_service_, slide_axis_;
+  std::string orchard_frame_, platform_frame_;
+  std::vector<std::string> topics_;
+  double slide_centre_;
+  int max_retries_;
+
+  ros::Publisher prompt_pub_, progress_pub_;
+  ros::ServiceServer start_srv_, cancel_srv_, in_place_srv_;
+  std::vector<ros::Subscriber> recorders_;
+  tf2_ros::StaticTransformBroadcaster static_tf_;
+
+  std::mutex bag_mutex_;
+  rosbag::Bag bag_;
+  bool recording_ = false;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool in_place_ = false;
+  std::atomic<bool> cancel_{false}, running_{false};
+  std::thread worker_;
+};
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,219 @@
+#include "dormant_tree_modeling/ros/acquisition_node.h"
+
+#include <dormant_tree_modeling/MoveAxis.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <std_msgs/String.h>
+
+#include <boost/bind/bind.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
+  const std::string plan_file = pnh.param<std::string>("plan_file", "");
+  if (!plan_file.empty())
+    plan_ = acquisition::loadViewPlan(plan_file);
+  plan_.validate();
+  output_dir_ = pnh.param<std::string>("output_dir", "scans");
+  tree_name_ = pnh.param<std::string>("tree_name", "tree");
+  move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
+  acquire_service_ =
+      pnh.param<std::string>("acquire_view_service", "/assembler/scan_assembler/acquire_view");
+  slide_axis_ = pnh.param<std::string>("slide_axis", "Y");
+  orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
+  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
+  slide_centre_ = pnh.param("slide_centre", 0.3);
+  max_retries_ = pnh.param("max_retries", 2);
+  topics_ = pnh.param<std::vector<std::string>>(
+      "record_topics",
+      {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static", "/assembler/view_cloud"});
+  if (tree_name_.empty() || tree_name_.find('/') != std::string::npos)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~tree_name must be a plain file name");
+  if (max_retries_ < 0 || max_retries_ > 10)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~max_retries must be in 0..10");
+  prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
+  progress_pub_ = pnh.advertise<std_msgs::String>("progress", 1, true);
+  start_srv_ = pnh.advertiseService("start", &AcquisitionNode::start, this);
+  cancel_srv_ = pnh.advertiseService("cancel", &AcquisitionNode::cancel, this);
+  in_place_srv_ =
+      pnh.advertiseService("platform_in_place", &AcquisitionNode::platformInPlace, this);
+  for (const auto& topic : topics_) {
+    recorders_.push_back(nh.subscribe<topic_tools::ShapeShifter>(
+        topic, 1000, boost::bind(&AcquisitionNode::record, this, topic, boost::placeholders::_1)));
+  }
+  publish(progress_pub_, "idle: " + std::to_string(acquisition::makeViewPlan(plan_).size()) +
+                             " views planned; call ~start");
+  if (pnh.param("autostart", false)) {
+    running_ = true;
+    worker_ = std::thread([this] { run(); });
+  }
+}
+
+AcquisitionNode::~AcquisitionNode() {
+  cancel_ = true;
+  wake_.notify_all();
+  if (worker_.joinable())
+    worker_.join();
+}
+
+void AcquisitionNode::publish(ros::Publisher& pub, const std::string& text) {
+  std_msgs::String m;
+  m.data = text;
+  pub.publish(m);
+}
+
+void AcquisitionNode::record(const std::string& topic,
+                             const topic_tools::ShapeShifter::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(bag_mutex_);
+  if (!recording_)
+    return;
+  try {
+    bag_.write(topic, ros::Time::now(), msg);
+  } catch (const rosbag::BagException& e) {
+    ROS_ERROR_THROTTLE(5.0, "recording %s failed: %s", topic.c_str(), e.what());
+  }
+}
+
+bool AcquisitionNode::start(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  if (running_.exchange(true)) {
+    res.success = false;
+    res.message = "a run is already going on";
+    return true;
+  }
+  if (worker_.joinable())
+    worker_.join();
+  cancel_ = false;
+  worker_ = std::thread([this] { run(); });
+  res.success = true;
+  res.message = "started";
+  return true;
+}
+
+bool AcquisitionNode::cancel(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  cancel_ = true;
+  wake_.notify_all();
+  res.success = running_;
+  res.message = running_ ? "cancelling after the current view" : "no run to cancel";
+  return true;
+}
+
+bool AcquisitionNode::platformInPlace(std_srvs::Trigger::Request&,
+                                      std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  in_place_ = true;
+  wake_.notify_all();
+  res.success = true;
+  res.message = "thanks";
+  return true;
+}
+
+bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
+  const Eigen::Vector3d t = view.platform.translation();
+  const double yaw = std::atan2(view.platform.linear()(1, 0), view.platform.linear()(0, 0));
+  std::ostringstream m;
+  m.precision(3);
+  m << "Move the platform to position " << view.platform_index + 1 << " (" << view.side << "): x "
+    << t.x() << " m, y " << t.y() << " m, laser height " << t.z() << " m, heading "
+    << yaw * 180.0 / M_PI << " deg in the tree frame; then call ~platform_in_place";
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    in_place_ = false;
+  }
+  publish(prompt_pub_, m.str());
+  ROS_INFO("%s", m.str().c_str());
+  std::unique_lock<std::mutex> lock(mutex_);
+  wake_.wait(lock, [&] { return in_place_ || cancel_ || !ros::ok(); });
+  if (!in_place_)
+    return false;
+  // The plan's pose is the registration's first guess for the views from here.
+  geometry_msgs::TransformStamped tf;
+  tf.header.stamp = ros::Time::now();
+  tf.header.frame_id = orchard_frame_;
+  tf.child_frame_id = platform_frame_;
+  tf.transform.translation.x = t.x();
+  tf.transform.translation.y = t.y();
+  tf.transform.translation.z = t.z();
+  const Eigen::Quaterniond q(view.platform.linear());
+  tf.transform.rotation.x = q.x();
+  tf.transform.rotation.y = q.y();
+  tf.transform.rotation.z = q.z();
+  tf.transform.rotation.w = q.w();
+  static_tf_.sendTransform(tf);
+  publish(prompt_pub_, "platform at position " + std::to_string(view.platform_index + 1));
+  return true;
+}
+
+void AcquisitionNode::run() {
+  const auto plan = acquisition::makeViewPlan(plan_);
+  std::filesystem::create_directories(output_dir_);
+  const std::string bag_path = output_dir_ + "/" + tree_name_ + ".bag";
+  try {
+    std::lock_guard<std::mutex> lock(bag_mutex_);
+    bag_.open(bag_path, rosbag::bagmode::Write);
+    recording_ = true;
+  } catch (const rosbag::BagException& e) {
+    publish(progress_pub_, std::string("cannot record to ") + bag_path + ": " + e.what());
+    ROS_ERROR("cannot record to %s: %s", bag_path.c_str(), e.what());
+    running_ = false;
+    return;
+  }
+  acquisition::SequencerActions a;
+  a.move_platform = [this](const acquisition::PlannedView& v) { return askForPlatform(v); };
+  a.move_slide = [this](double slide) {
+    dormant_tree_modeling::MoveAxis m;
+    m.request.axis = slide_axis_;
+    m.request.target = slide_centre_ + slide;
+    m.request.wait = true;
+    if (!ros::service::call(move_service_, m))
+      throw Error(ErrorCode::IO_FAILURE,
+                  "the stage service " + move_service_ + " is not available");
+    if (!m.response.success)
+      throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
+  };
+  a.acquire_view = [this](const acquisition::PlannedView&) {
+    std_srvs::Trigger t;
+    if (!ros::service::call(acquire_service_, t))
+      throw Error(ErrorCode::IO_FAILURE,
+                  "the assembler service " + acquire_service_ + " is not available");
+    if (!t.response.success)
+      throw Error(ErrorCode::IO_FAILURE, t.response.message);
+    return t.response.message;
+  };
+  a.progress = [this](const acquisition::SequencerProgress& p) {
+    std::ostringstream m;
+    m.precision(3);
+    m << p.done << " of " << p.total << " views done, " << p.failed << " failed, "
+      << p.elapsed_s / 60.0 << " min elapsed, about " << p.remaining_s / 60.0
+      << " min left: " << p.message;
+    publish(progress_pub_, m.str());
+    ROS_INFO("%s", m.str().c_str());
+  };
+  a.cancelled = [this] { return cancel_.load() || !ros::ok(); };
+  std::vector<acquisition::ViewOutcome> outcomes;
+  try {
+    outcomes = acquisition::runPlan(plan, a, max_retries_);
+  } catch (const Error& e) {
+    ROS_ERROR("acquisition stopped: %s", e.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(bag_mutex_);
+    recording_ = false;
+    bag_.close();
+  }
+  const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
+  std::ofstream(output_dir_ + "/" + tree_name_ + "_report.md")
+      << "# Acquisition of " << tree_name_ << "\n\nBag: " << bag_path << "\n\n"
+      << report;
+  publish(progress_pub_, "finished: " + report.substr(0, report.find('\n')));
+  ROS_INFO("acquisition finished: %s", report.substr(0, report.find('\n')).c_str());
+  running_ = false;
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,84 @@
+// The acquisition sequencer's run logic: one operator move per platform position, a slide
+// move and a sweep per view, retries, failures reported and the run going on, cancellation.
+#include <gtest/gtest.h>
+
+#include "dormant_tree_modeling/acquisition/sequencer.h"
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace acquisition {
+namespace {
+
+std::vector<PlannedView> shortPlan() {
+  ViewPlanConfig c;
+  c.heights = {1.5};
+  c.positions_per_height = 2;
+  c.slide_steps = 3;
+  c.back = false;
+  return makeViewPlan(c);  // 2 positions x 3 views
+}
+
+TEST(Sequencer, RetriesReportsFailuresAndGoesOn) {
+  const auto plan = shortPlan();
+  ASSERT_EQ(plan.size(), 6u);
+  std::vector<int> platform_moves;
+  std::vector<double> slides;
+  int sweeps = 0;
+  std::vector<SequencerProgress> progress;
+  SequencerActions a;
+  a.move_platform = [&](const PlannedView& v) {
+    platform_moves.push_back(v.platform_index);
+    return true;
+  };
+  a.move_slide = [&](double s) { slides.push_back(s); };
+  a.acquire_view = [&](const PlannedView& v) -> std::string {
+    ++sweeps;
+    if (v.index == 1 && sweeps == 2)
+      throw Error(ErrorCode::IO_FAILURE, "laser dropped");  // once: the retry succeeds
+    if (v.index == 4)
+      throw Error(ErrorCode::IO_FAILURE, "axis X faulted");  // always: reported
+    return "view " + std::to_string(v.index);
+  };
+  a.progress = [&](const SequencerProgress& p) { progress.push_back(p); };
+  const auto out = runPlan(plan, a, 2);
+  ASSERT_EQ(out.size(), 6u);
+  EXPECT_EQ(platform_moves, (std::vector<int>{0, 1}));
+  EXPECT_TRUE(out[1].ok);
+  EXPECT_EQ(out[1].attempts, 2);
+  EXPECT_FALSE(out[4].ok);
+  EXPECT_EQ(out[4].attempts, 3);
+  EXPECT_EQ(out[4].message, "axis X faulted");
+  EXPECT_TRUE(out[5].ok);  // the run went on
+  EXPECT_EQ(sweeps, 6 + 1 + 2);
+  EXPECT_NEAR(slides[0], -0.1, 1e-12);  // centred on the slide
+  EXPECT_EQ(progress.back().done, 5);
+  EXPECT_EQ(progress.back().failed, 1);
+  const std::string md = outcomesMarkdown(out, 6);
+  EXPECT_EQ(md.rfind("5 of 6 planned views acquired", 0), 0u) << md;
+  EXPECT_NE(md.find("| 5 | FAILED | 3 |"), std::string::npos) << md;
+}
+
+TEST(Sequencer, StopsWhenTheOperatorOrTheUserCancels) {
+  const auto plan = shortPlan();
+  SequencerActions a;
+  a.move_platform = [](const PlannedView& v) { return v.platform_index == 0; };
+  a.move_slide = [](double) {};
+  a.acquire_view = [](const PlannedView&) { return std::string("ok"); };
+  EXPECT_EQ(runPlan(plan, a, 0).size(), 3u);  // the second position was refused
+  int views = 0;
+  a.move_platform = [](const PlannedView&) { return true; };
+  a.acquire_view = [&](const PlannedView&) {
+    ++views;
+    return std::string("ok");
+  };
+  a.cancelled = [&] { return views >= 2; };
+  const auto out = runPlan(plan, a, 0);
+  EXPECT_EQ(out.size(), 2u);
+  EXPECT_NE(outcomesMarkdown(out, 6).find("run stopped after 2"), std::string::npos);
+  a.move_slide = nullptr;
+  EXPECT_THROW(runPlan(plan, a, 0), Error);
+}
+
+}  // namespace
+}  // namespace acquisition
+}  // namespace dormant_tree_modeling
