@@ -41,7 +41,8 @@ std::optional<double> StagePositionHistory::at(double stamp) const {
 
 RangeImage assembleRangeImage(const std::vector<SweepLine>& lines,
                               const StagePositionHistory& history, double theta_min,
-                              double theta_max, std::size_t* dropped) {
+                              double theta_max, std::size_t* dropped, double theta_step,
+                              std::size_t* missing) {
   struct Row {
     double theta0, rate, centre;
     const SweepLine* line;
@@ -74,6 +75,27 @@ RangeImage assembleRangeImage(const std::vector<SweepLine>& lines,
   }
   std::stable_sort(rows.begin(), rows.end(),
                    [](const Row& a, const Row& b) { return a.centre < b.centre; });
+  if (missing)
+    *missing = 0;
+  if (theta_step > 0 && !rows.empty()) {
+    // One row per nominal angle: the nearest line within half a step, else an empty row.
+    const int n = static_cast<int>(std::ceil((theta_max - theta_min) / theta_step - 1e-9));
+    std::vector<Row> grid;
+    for (int k = 0; k < n; ++k) {
+      const double nominal = theta_min + k * theta_step;
+      const auto best = std::min_element(rows.begin(), rows.end(), [&](const Row& a, const Row& b) {
+        return std::abs(a.centre - nominal) < std::abs(b.centre - nominal);
+      });
+      if (std::abs(best->centre - nominal) <= 0.5 * theta_step) {
+        grid.push_back(*best);
+      } else {
+        grid.push_back({nominal, 0.0, nominal, nullptr});
+        if (missing)
+          ++*missing;
+      }
+    }
+    rows = std::move(grid);
+  }
   RangeImage image;
   if (rows.empty()) {
     if (dropped)
@@ -87,13 +109,16 @@ RangeImage assembleRangeImage(const std::vector<SweepLine>& lines,
   image.theta_step =
       rows.size() > 1 ? (rows.back().centre - rows.front().centre) / (rows.size() - 1) : 0.0;
   const bool rssi = std::all_of(rows.begin(), rows.end(), [&](const Row& r) {
-    return r.line->intensities.size() == r.line->ranges.size();
+    return !r.line || r.line->intensities.size() == r.line->ranges.size();
   });
   if (rssi)
     image.rssi.assign(image.range.size(), 0);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     image.row_theta.push_back(rows[i].theta0);
     image.row_theta_rate.push_back(rows[i].rate);
+    image.row_stamp.push_back(rows[i].line ? rows[i].line->stamp : 0.0);
+    if (!rows[i].line)
+      continue;  // a missing line: no returns
     const SweepLine& l = *rows[i].line;
     for (int j = 0; j < image.cols; ++j) {
       const float r = l.ranges[j];

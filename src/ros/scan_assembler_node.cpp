@@ -26,27 +26,27 @@ constexpr double ROS_TO_DEVICE_ANGLE = M_PI / 2;
 
 ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     : nh_(nh), tf_listener_(tf_buffer_), history_(0.1) {
-  mode_ = pnh.param<std::string>("mode", "continuous");
-  if (mode_ != "continuous" && mode_ != "step")
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode_);
+  const std::string mode = pnh.param<std::string>("mode", "continuous");
+  if (mode != "continuous" && mode != "step")
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode);
+  sweep_.continuous = mode == "continuous";
   rotary_axis_ = pnh.param<std::string>("rotary_axis", "X");
   rotary_joint_ = pnh.param<std::string>("rotary_joint", "rotary_stage_joint");
   move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
   platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
   stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
-  theta_min_deg_ = pnh.param("theta_min", -45.0);
-  theta_max_deg_ = pnh.param("theta_max", 45.0);
-  theta_step_deg_ = pnh.param("theta_step", 0.45);
-  sweep_margin_deg_ = pnh.param("sweep_margin", 2.0);
+  sweep_.theta_min = pnh.param("theta_min", sweep_.theta_min);
+  sweep_.theta_max = pnh.param("theta_max", sweep_.theta_max);
+  sweep_.theta_step = pnh.param("theta_step", sweep_.theta_step);
+  sweep_.margin = pnh.param("sweep_margin", sweep_.margin);
+  sweep_.settle_s = pnh.param("settle_time", sweep_.settle_s);
+  sweep_.validate();
   tree_distance_ = pnh.param("tree_distance", 1.5);
-  settle_s_ = pnh.param("settle_time", 0.02);
+  max_missing_rows_ = pnh.param("max_missing_rows", 0.05);
   buffer_s_ = pnh.param("buffer_seconds", 60.0);
-  if (!(theta_min_deg_ < theta_max_deg_ && theta_step_deg_ > 0 && sweep_margin_deg_ >= 0 &&
-        tree_distance_ > 0 && settle_s_ >= 0 && buffer_s_ > 10)) {
+  if (!(tree_distance_ > 0 && buffer_s_ > 10 && max_missing_rows_ >= 0 && max_missing_rows_ < 1))
     throw Error(ErrorCode::INVALID_ARGUMENT,
-                "need theta_min < theta_max, theta_step > 0, sweep_margin >= 0, tree_distance > "
-                "0, settle_time >= 0, buffer_seconds > 10");
-  }
+                "need tree_distance > 0, buffer_seconds > 10 and 0 <= max_missing_rows < 1");
   auto& p = processing_;
   p.floating_threshold = pnh.param("floating_threshold", p.floating_threshold);
   p.smoothing_iterations = pnh.param("smoothing_iterations", p.smoothing_iterations);
@@ -83,6 +83,7 @@ void ScanAssemblerNode::jointCallback(const sensor_msgs::JointStateConstPtr& msg
     if (msg->name[i] == rotary_joint_) {
       std::lock_guard<std::mutex> lock(mutex_);
       history_.add(msg->header.stamp.toSec(), msg->position[i]);
+      last_theta_ = msg->position[i];
     }
   }
 }
@@ -128,56 +129,44 @@ std::vector<acquisition::SweepLine> ScanAssemblerNode::linesBetween(double t0, d
 }
 
 std::string ScanAssemblerNode::acquire() {
-  const double period = lastScanPeriod();
   const ros::WallTime started = ros::WallTime::now();
-  std::vector<acquisition::SweepLine> lines;
-  if (mode_ == "continuous") {
-    // One θ step per scan period; the margins let the stage reach speed before θ_min.
-    moveRotary(theta_min_deg_ - sweep_margin_deg_, 0.0);
-    const double t0 = ros::Time::now().toSec();
-    moveRotary(theta_max_deg_ + sweep_margin_deg_, theta_step_deg_ / period);
-    lines = linesBetween(t0, ros::Time::now().toSec());
-  } else {
-    const int steps =
-        static_cast<int>(std::ceil((theta_max_deg_ - theta_min_deg_) / theta_step_deg_ - 1e-9));
-    for (int k = 0; k < steps; ++k) {
-      moveRotary(theta_min_deg_ + k * theta_step_deg_, 0.0);
-      const double settled = ros::Time::now().toSec() + settle_s_;
-      // The first line that starts after the stage settled.
-      const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(5 * period + 1.0);
-      bool got = false;
-      while (!got && ros::WallTime::now() < give_up) {
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          for (const auto& l : lines_) {
-            if (l.stamp > settled) {
-              lines.push_back(l);
-              got = true;
-              break;
-            }
-          }
-        }
-        if (!got)
-          ros::WallDuration(0.002).sleep();
-      }
-      if (!got)
-        throw Error(ErrorCode::IO_FAILURE, "no scan line at step " + std::to_string(k));
-    }
-  }
-  ros::WallDuration(0.1).sleep();  // the last joint states of the sweep
-  acquisition::RangeImage image;
-  std::size_t dropped = 0;
-  {
+  acquisition::SweepIo io;
+  io.now = [] { return ros::Time::now().toSec(); };
+  io.rotary_position = [this] {
     std::lock_guard<std::mutex> lock(mutex_);
-    image = acquisition::assembleRangeImage(lines, history_, theta_min_deg_ * DEG,
-                                            theta_max_deg_ * DEG, &dropped);
+    return last_theta_ / DEG;
+  };
+  io.move_rotary = [this](double target, double velocity) { moveRotary(target, velocity); };
+  io.scan_period = [this] { return lastScanPeriod(); };
+  io.lines_between = [this](double t0, double t1) { return linesBetween(t0, t1); };
+  io.first_line_after = [this](double t, double timeout) {
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (ros::WallTime::now() < give_up) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& l : lines_) {
+          if (l.stamp > t)
+            return std::optional<acquisition::SweepLine>(l);
+        }
+      }
+      ros::WallDuration(0.002).sleep();
+    }
+    return std::optional<acquisition::SweepLine>();
+  };
+  io.history = [this] {
+    ros::WallDuration(0.05).sleep();  // the joint states of the sweep's last moments
+    std::lock_guard<std::mutex> lock(mutex_);
+    return history_;
+  };
+  std::size_t dropped = 0, missing = 0;
+  acquisition::RangeImage image = acquisition::runSweep(io, sweep_, &dropped, &missing);
+  // A laser that dropped out mid-sweep leaves empty rows: fail the view so it is retried.
+  if (missing > max_missing_rows_ * image.rows) {
+    throw Error(ErrorCode::IO_FAILURE, std::to_string(missing) + " of " +
+                                           std::to_string(image.rows) +
+                                           " scan lines missing (did the laser drop out?)");
   }
-  if (image.rows == 0) {
-    throw Error(ErrorCode::EMPTY_INPUT, "no scan line of the sweep had stage positions (" +
-                                            std::to_string(dropped) + " lines dropped)");
-  }
-  const double mid = lines[lines.size() / 2].stamp;
-  const auto stamp = ros::Time(mid);
+  const auto stamp = ros::Time(image.row_stamp[image.rows / 2]);
   Eigen::Isometry3d stage_in_platform;
   try {
     stage_in_platform = tf2::transformToEigen(
@@ -202,10 +191,10 @@ std::string ScanAssemblerNode::acquire() {
       image, stage_in_platform, Eigen::Vector2d(tree_distance_, 0.0), processing_);
   cloud_pub_.publish(toMsg(*view.cloud, platform_frame_, stamp));
   std::ostringstream m;
-  m << image.rows << " x " << image.cols << " range image (" << dropped
-    << " lines without stage positions), " << view.floating_removed << " floating pixels removed, "
-    << view.cloud->size() << " points in the view in " << (ros::WallTime::now() - started).toSec()
-    << " s";
+  m << image.rows << " x " << image.cols << " range image (" << missing << " rows without a line, "
+    << dropped << " lines without stage positions), " << view.floating_removed
+    << " floating pixels removed, " << view.cloud->size() << " points in the view in "
+    << (ros::WallTime::now() - started).toSec() << " s";
   return m.str();
 }
 

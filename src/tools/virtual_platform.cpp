@@ -9,12 +9,9 @@
 #include <thread>
 
 #include "command_line.h"
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
-#include "dormant_tree_modeling/aerotech/ensemble_server.h"
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/lms111/emulator_server.h"
-#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
+#include "dormant_tree_modeling/simulation/virtual_platform.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
@@ -71,25 +68,6 @@ int main(int argc, char** argv) {
       return 0;
     if (platform.size() != 4)
       throw Error(ErrorCode::INVALID_ARGUMENT, "--platform takes x y z yaw_deg");
-    if (frequency != 25.0 && frequency != 50.0)
-      throw Error(ErrorCode::INVALID_ARGUMENT, "--frequency must be 25 or 50");
-
-    aerotech::EmulatedAxisConfig rotary, slide;
-    rotary.name = "X";
-    rotary.max_velocity = 180.0;
-    rotary.acceleration = 720.0;
-    rotary.home_velocity = 90.0;
-    rotary.min_limit = -360.0;
-    rotary.max_limit = 360.0;
-    slide.name = "Y";
-    slide.max_velocity = 200.0;
-    slide.acceleration = 1000.0;
-    slide.home_velocity = 200.0;
-    slide.min_limit = -5.0;
-    slide.max_limit = 605.0;
-    auto ensemble = std::make_shared<aerotech::EmulatedEnsemble>(
-        std::vector<aerotech::EmulatedAxisConfig>{rotary, slide}, faults);
-    aerotech::EnsembleServer stage(ensemble, "127.0.0.1", aerotech_port);
 
     simulation::Scene scene;
     if (!scene_path.empty()) {
@@ -99,31 +77,19 @@ int main(int argc, char** argv) {
       orchard.preset = preset;
       scene = simulation::generateOrchard(orchard, seed).scene;
     }
-    simulation::Lms111Config sensor;
-    sensor.range_noise_sigma = noise_mm / 1000.0;
-    const Eigen::Isometry3d platform_pose =
+    simulation::VirtualPlatformOptions o;
+    o.laser = lms;
+    o.stage_port = aerotech_port;
+    o.scan_frequency_hz = frequency;
+    o.range_noise_sigma = noise_mm / 1000.0;
+    o.seed = seed;
+    o.platform =
         acquisition::platformPose(platform[0], platform[1], platform[2], platform[3] * M_PI / 180);
-    // As config/stage_controller.yaml mounts it: the platform frame at the slide's centre.
-    acquisition::StageGeometry geometry;
-    geometry.platform_to_slide_base = Eigen::Vector3d(0.0, -0.3, 0.0);
-    const double period = 1.0 / frequency;
-    // A simulated line is taken from one pose: the stage's at the line's middle beam (135 of
-    // the mirror's 360 deg after the first ray), where the tree is.
-    auto pose = [&, period](double) {
-      const double t = stage.now() + 0.375 * period;
-      const double theta = ensemble->position("X", t) * M_PI / 180.0;
-      const double slide_m = ensemble->position("Y", t) / 1000.0;
-      return acquisition::laserPose(acquisition::stagePose(platform_pose, geometry, slide_m),
-                                    geometry, theta);
-    };
-    auto source = std::make_shared<lms111::SimulatedScanSource>(scene, pose, sensor, seed);
-    lms111::EmulatorConfig device;
-    device.scan.frequency = device.scan.resolution = frequency == 25.0 ? 2500 : 5000;
-    auto laser = std::make_shared<lms111::EmulatedLms111>(device, source);
-    lms111::EmulatorServer laser_server(laser, lms);
-    std::cout << "virtual_platform: LMS111 on 127.0.0.1:" << laser_server.colaAPort()
-              << " (CoLa-A), " << laser_server.colaBPort()
-              << " (CoLa-B); Aerotech on 127.0.0.1:" << stage.port() << std::endl;
+    o.stage_faults = faults;
+    simulation::VirtualPlatform vp(scene, o);
+    std::cout << "virtual_platform: LMS111 on 127.0.0.1:" << vp.laserPort() << " (CoLa-A), "
+              << vp.laserColaBPort() << " (CoLa-B); Aerotech on 127.0.0.1:" << vp.stagePort()
+              << std::endl;
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
     const auto start = std::chrono::steady_clock::now();
@@ -133,8 +99,7 @@ int main(int argc, char** argv) {
           std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
         break;
     }
-    laser_server.stop();
-    stage.stop();
+    vp.stop();
     return 0;
   } catch (const po::error& e) {
     std::cerr << "virtual_platform: " << e.what() << "\n" << desc << "\n";

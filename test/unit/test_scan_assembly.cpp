@@ -61,6 +61,20 @@ TEST(AssembleRangeImage, ContinuousSweepGivesEachBeamItsTheta) {
   EXPECT_EQ(img.at(0, 3), 0.0f);  // NaN -> no return
   for (int i = 1; i < img.rows; ++i)
     EXPECT_GT(img.theta(i), img.theta(i - 1));
+  // On the nominal grid of 0.45 deg: the same 200 rows, one per step.
+  std::size_t missing = 1;
+  const RangeImage grid =
+      assembleRangeImage(lines, h, -M_PI / 4, M_PI / 4, nullptr, 0.45 * M_PI / 180, &missing);
+  EXPECT_EQ(grid.rows, 200);
+  EXPECT_EQ(missing, 0u);
+  EXPECT_NEAR(grid.theta(10), img.theta(10), 1e-12);
+  // Half the sweep's lines lost: their rows stay empty and are counted.
+  std::vector<SweepLine> half(lines.begin(), lines.begin() + 100);
+  const RangeImage holes =
+      assembleRangeImage(half, h, -M_PI / 4, M_PI / 4, nullptr, 0.45 * M_PI / 180, &missing);
+  EXPECT_EQ(holes.rows, 200);
+  EXPECT_EQ(missing, 100u);
+  EXPECT_EQ(holes.at(150, 0), 0.0f);
   // Without stage feedback for a line it is dropped, not guessed.
   StagePositionHistory partial;
   for (int i = 0; i <= 100; ++i)

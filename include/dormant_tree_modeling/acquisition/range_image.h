@@ -24,6 +24,7 @@ struct RangeImage {
   /// Optional, per row: how theta changes along the row (rad per column), for a stage that
   /// turns while the line is measured (a continuous sweep). Empty: constant along a row.
   std::vector<double> row_theta_rate;
+  std::vector<double> row_stamp;  ///< optional: time of each row's first beam (s)
 
   /// @brief Allocate rows x cols invalid pixels.
   void resize(int r, int c);

@@ -48,10 +48,14 @@ class StagePositionHistory {
 /// @brief The range image of one sweep: the lines whose θ (at their middle beam) lies in
 /// [theta_min, theta_max), ordered by θ, each with its θ at beam 0 and its θ rate along the
 /// beams. Lines without stage coverage are dropped and counted.
+/// @param theta_step when > 0, one row per nominal θ_min + k·step (k < (max - min) / step):
+///        the line nearest to it within half a step, or an empty row (counted in `missing`),
+///        so that every view has the plan's row count whatever the phase of the laser
 /// @throws Error INVALID_ARGUMENT when the lines disagree in beam count or angles
 RangeImage assembleRangeImage(const std::vector<SweepLine>& lines,
                               const StagePositionHistory& history, double theta_min,
-                              double theta_max, std::size_t* dropped = nullptr);
+                              double theta_max, std::size_t* dropped = nullptr,
+                              double theta_step = 0.0, std::size_t* missing = nullptr);
 
 /// @brief Eq. 1's floating-pixel filter: remove pixel (i, j) when it differs from every one of
 /// its 8 neighbours by more than rho_t (an invalid or missing neighbour counts as different).

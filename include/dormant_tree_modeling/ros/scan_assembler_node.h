@@ -10,6 +10,7 @@
 #include <deque>
 #include <mutex>
 
+#include "dormant_tree_modeling/acquisition/sweep.h"
 #include "dormant_tree_modeling/acquisition/sweep_assembler.h"
 #include "dormant_tree_modeling/acquisition/view_processing.h"
 
@@ -42,9 +43,9 @@ class ScanAssemblerNode {
   std::vector<acquisition::SweepLine> linesBetween(double t0, double t1);
   double lastScanPeriod();
 
-  std::string mode_, rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_;
-  double theta_min_deg_, theta_max_deg_, theta_step_deg_, sweep_margin_deg_, tree_distance_;
-  double settle_s_, buffer_s_;
+  std::string rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_;
+  acquisition::SweepSettings sweep_;
+  double tree_distance_, buffer_s_, max_missing_rows_;
   acquisition::ViewProcessingConfig processing_;
 
   ros::NodeHandle nh_;
@@ -58,6 +59,7 @@ class ScanAssemblerNode {
   std::deque<acquisition::SweepLine> lines_;
   acquisition::StagePositionHistory history_;
   double last_period_ = 0.0;
+  double last_theta_ = 0.0;   // rad, latest rotary joint position
   std::mutex acquire_mutex_;  // one sweep at a time
 };
 

@@ -1,0 +1,64 @@
+#include "dormant_tree_modeling/simulation/virtual_platform.h"
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+
+namespace dormant_tree_modeling {
+namespace simulation {
+
+VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOptions& o) {
+  if (o.scan_frequency_hz != 25.0 && o.scan_frequency_hz != 50.0)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "the LMS111 runs at 25 or 50 Hz");
+  aerotech::EmulatedAxisConfig rotary, slide;
+  rotary.name = "X";
+  rotary.max_velocity = 180.0;
+  rotary.acceleration = 720.0;
+  rotary.home_velocity = 90.0;
+  rotary.min_limit = -360.0;
+  rotary.max_limit = 360.0;
+  slide.name = "Y";
+  slide.max_velocity = 200.0;
+  slide.acceleration = 1000.0;
+  slide.home_velocity = 200.0;
+  slide.min_limit = -5.0;
+  slide.max_limit = 605.0;
+  ensemble_ = std::make_shared<aerotech::EmulatedEnsemble>(
+      std::vector<aerotech::EmulatedAxisConfig>{rotary, slide}, o.stage_faults);
+  stage_ = std::make_unique<aerotech::EnsembleServer>(ensemble_, "127.0.0.1", o.stage_port);
+
+  Lms111Config sensor;
+  sensor.range_noise_sigma = o.range_noise_sigma;
+  const double period = 1.0 / o.scan_frequency_hz;
+  aerotech::EnsembleServer* stage = stage_.get();
+  auto ensemble = ensemble_;
+  const Eigen::Isometry3d platform = o.platform;
+  const acquisition::StageGeometry geometry = o.geometry;
+  // The middle beam (135 of the mirror's 360 deg after the first ray) looks at the tree.
+  auto pose = [stage, ensemble, platform, geometry, period](double) {
+    const double t = stage->now() + 0.375 * period;
+    const double theta = ensemble->position("X", t) * M_PI / 180.0;
+    const double slide_m = ensemble->position("Y", t) / 1000.0;
+    return acquisition::laserPose(acquisition::stagePose(platform, geometry, slide_m), geometry,
+                                  theta);
+  };
+  auto source = std::make_shared<lms111::SimulatedScanSource>(scene, pose, sensor, o.seed);
+  lms111::EmulatorConfig device;
+  device.scan.frequency = device.scan.resolution = o.scan_frequency_hz == 25.0 ? 2500 : 5000;
+  laser_ = std::make_unique<lms111::EmulatorServer>(
+      std::make_shared<lms111::EmulatedLms111>(device, source, o.laser_faults), o.laser);
+}
+
+VirtualPlatform::~VirtualPlatform() {
+  stop();
+}
+
+void VirtualPlatform::stop() {
+  // The laser's scans read the stage: stop the laser first.
+  if (laser_)
+    laser_->stop();
+  if (stage_)
+    stage_->stop();
+}
+
+}  // namespace simulation
+}  // namespace dormant_tree_modeling
