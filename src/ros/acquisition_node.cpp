@@ -30,6 +30,7 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
   slide_centre_ = pnh.param("slide_centre", 0.3);
   max_retries_ = pnh.param("max_retries", 2);
+  drain_s_ = pnh.param("drain_seconds", 1.0);
   topics_ = pnh.param<std::vector<std::string>>(
       "record_topics",
       {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static", "/assembler/view_cloud"});
@@ -37,6 +38,8 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
     throw Error(ErrorCode::INVALID_ARGUMENT, "~tree_name must be a plain file name");
   if (max_retries_ < 0 || max_retries_ > 10)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~max_retries must be in 0..10");
+  if (drain_s_ < 0 || drain_s_ > 60)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~drain_seconds must be in 0..60");
   prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
   progress_pub_ = pnh.advertise<std_msgs::String>("progress", 1, true);
   start_srv_ = pnh.advertiseService("start", &AcquisitionNode::start, this);
@@ -201,6 +204,9 @@ void AcquisitionNode::run() {
   } catch (const Error& e) {
     ROS_ERROR("acquisition stopped: %s", e.what());
   }
+  // Messages of the last view may still be in transit (the view cloud is published just
+  // before acquire_view returns): let them arrive before the bag closes.
+  ros::WallDuration(drain_s_).sleep();
   {
     std::lock_guard<std::mutex> lock(bag_mutex_);
     recording_ = false;

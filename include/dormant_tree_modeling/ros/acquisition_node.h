@@ -48,6 +48,7 @@ class AcquisitionNode {
   std::vector<std::string> topics_;
   double slide_centre_;
   int max_retries_;
+  double drain_s_;  // wait for in-flight messages before the bag closes
 
   ros::Publisher prompt_pub_, progress_pub_;
   ros::ServiceServer start_srv_, cancel_srv_, in_place_srv_;
