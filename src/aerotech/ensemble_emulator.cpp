@@ -62,6 +62,23 @@ double profileDistance(double d, double v, double a, double t) {
 
 }  // namespace
 
+std::vector<EmulatedAxisConfig> defaultStageAxes() {
+  EmulatedAxisConfig rotary, slide;
+  rotary.name = "X";
+  rotary.max_velocity = 180.0;
+  rotary.acceleration = 720.0;
+  rotary.home_velocity = 90.0;
+  rotary.min_limit = -360.0;
+  rotary.max_limit = 360.0;
+  slide.name = "Y";
+  slide.max_velocity = 200.0;
+  slide.acceleration = 1000.0;
+  slide.home_velocity = 200.0;
+  slide.min_limit = -5.0;  // a little travel beyond the soft limits (0 ... 600 mm)
+  slide.max_limit = 605.0;
+  return {rotary, slide};
+}
+
 EmulatedEnsemble::EmulatedEnsemble(std::vector<EmulatedAxisConfig> axes, EnsembleFaults faults)
     : faults_(std::move(faults)) {
   for (const auto& c : axes) {

@@ -9,21 +9,8 @@ namespace simulation {
 VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOptions& o) {
   if (o.scan_frequency_hz != 25.0 && o.scan_frequency_hz != 50.0)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the LMS111 runs at 25 or 50 Hz");
-  aerotech::EmulatedAxisConfig rotary, slide;
-  rotary.name = "X";
-  rotary.max_velocity = 180.0;
-  rotary.acceleration = 720.0;
-  rotary.home_velocity = 90.0;
-  rotary.min_limit = -360.0;
-  rotary.max_limit = 360.0;
-  slide.name = "Y";
-  slide.max_velocity = 200.0;
-  slide.acceleration = 1000.0;
-  slide.home_velocity = 200.0;
-  slide.min_limit = -5.0;
-  slide.max_limit = 605.0;
-  ensemble_ = std::make_shared<aerotech::EmulatedEnsemble>(
-      std::vector<aerotech::EmulatedAxisConfig>{rotary, slide}, o.stage_faults);
+  ensemble_ =
+      std::make_shared<aerotech::EmulatedEnsemble>(aerotech::defaultStageAxes(), o.stage_faults);
   stage_ = std::make_unique<aerotech::EnsembleServer>(ensemble_, "127.0.0.1", o.stage_port);
 
   Lms111Config sensor;

@@ -1,45 +1,20 @@
 // aerotech_emulator: an Aerotech Ensemble on 127.0.0.1 with a rotary stage (X, deg) and a
 // linear slide (Y, mm), with fault injection for tests.
 #include <boost/program_options.hpp>
-#include <chrono>
-#include <csignal>
 #include <iostream>
-#include <thread>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/aerotech/ensemble_server.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "serve_loop.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
-
-namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-
-void onSignal(int) {
-  g_stop = 1;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::string address = "127.0.0.1";
   int port = 8000;
   double duration = 0.0;
-  aerotech::EmulatedAxisConfig rotary, slide;
-  rotary.name = "X";
-  rotary.max_velocity = 180.0;
-  rotary.acceleration = 720.0;
-  rotary.home_velocity = 60.0;
-  rotary.min_limit = -360.0;
-  rotary.max_limit = 360.0;
-  slide.name = "Y";
-  slide.max_velocity = 200.0;
-  slide.acceleration = 1000.0;
-  slide.home_velocity = 100.0;
-  slide.min_limit = -5.0;
-  slide.max_limit = 605.0;
   aerotech::EnsembleFaults faults;
   std::vector<std::string> invalid;
   po::options_description desc(
@@ -59,28 +34,16 @@ int main(int argc, char** argv) {
       "invalid", po::value(&invalid)->composing(), "fault: answer '!' to this command word")(
       "duration", po::value(&duration)->default_value(duration), "seconds to run, 0 = forever");
   try {
-    std::vector<char*> args;
-    for (int i = 0; i < argc; ++i) {
-      if (i == 0 || std::string(argv[i]).find(":=") == std::string::npos)
-        args.push_back(argv[i]);  // roslaunch's __name:= and remappings are not ours
-    }
+    auto args = tools::withoutRosArguments(argc, argv);
     po::variables_map vm;
     if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
       return 0;
     faults.invalid_commands.insert(invalid.begin(), invalid.end());
-    auto controller = std::make_shared<aerotech::EmulatedEnsemble>(
-        std::vector<aerotech::EmulatedAxisConfig>{rotary, slide}, faults);
+    auto controller =
+        std::make_shared<aerotech::EmulatedEnsemble>(aerotech::defaultStageAxes(), faults);
     aerotech::EnsembleServer server(controller, address, port);
     std::cout << "aerotech_emulator: listening on " << address << ":" << server.port() << std::endl;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-    const auto start = std::chrono::steady_clock::now();
-    while (!g_stop) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      if (duration > 0 &&
-          std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
-        break;
-    }
+    tools::serveUntilStopped(duration);
     server.stop();
     std::cout << "aerotech_emulator: " << server.connectionsAccepted() << " connections"
               << std::endl;

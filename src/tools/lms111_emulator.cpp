@@ -1,39 +1,17 @@
 // lms111_emulator: a SICK LMS111 on 127.0.0.1 (CoLa-A and CoLa-B), scanning a synthetic
 // orchard or replaying a recorded telegram, with fault injection for tests.
 #include <boost/program_options.hpp>
-#include <chrono>
-#include <csignal>
 #include <iostream>
-#include <thread>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/emulator_server.h"
 #include "dormant_tree_modeling/lms111/simulated_scan_source.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
+#include "serve_loop.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
-
-namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-
-void onSignal(int) {
-  g_stop = 1;
-}
-
-// roslaunch appends __name:=..., __log:=... (and remappings); they are not ours.
-std::vector<char*> withoutRosArguments(int argc, char** argv) {
-  std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    if (i == 0 || std::string(argv[i]).find(":=") == std::string::npos)
-      args.push_back(argv[i]);
-  }
-  return args;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   lms111::EmulatorServerOptions server;
@@ -81,7 +59,7 @@ int main(int argc, char** argv) {
                                 "fault: NAME:CODE[:TIMES] answer sFA CODE to command NAME")(
       "duration", po::value(&duration)->default_value(duration), "seconds to run, 0 = forever");
   try {
-    auto args = withoutRosArguments(argc, argv);
+    auto args = tools::withoutRosArguments(argc, argv);
     po::variables_map vm;
     if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
       return 0;
@@ -114,15 +92,7 @@ int main(int argc, char** argv) {
     lms111::EmulatorServer running(emulated, server);
     std::cout << "lms111_emulator: listening on " << server.address << ", CoLa-A port "
               << running.colaAPort() << ", CoLa-B port " << running.colaBPort() << std::endl;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-    const auto start = std::chrono::steady_clock::now();
-    while (!g_stop) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      if (duration > 0 &&
-          std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
-        break;
-    }
+    tools::serveUntilStopped(duration);
     running.stop();
     std::cout << "lms111_emulator: " << running.connectionsAccepted() << " connections, "
               << running.telegramsSent() << " scan telegrams sent" << std::endl;

@@ -3,28 +3,16 @@
 // one synthetic orchard: the laser scans from the pose the emulated stage is in, so the
 // driver, stage controller and scan assembler run unchanged against it.
 #include <boost/program_options.hpp>
-#include <chrono>
-#include <csignal>
 #include <iostream>
-#include <thread>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/virtual_platform.h"
+#include "serve_loop.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
-
-namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-
-void onSignal(int) {
-  g_stop = 1;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   lms111::EmulatorServerOptions lms;
@@ -58,11 +46,7 @@ int main(int argc, char** argv) {
       "fault-on-move", po::value(&faults.fault_on_move), "... half-way through its N-th move")(
       "duration", po::value(&duration)->default_value(duration), "seconds to run, 0 = forever");
   try {
-    std::vector<char*> args;
-    for (int i = 0; i < argc; ++i) {
-      if (i == 0 || std::string(argv[i]).find(":=") == std::string::npos)
-        args.push_back(argv[i]);  // roslaunch's __name:= and remappings are not ours
-    }
+    auto args = tools::withoutRosArguments(argc, argv);
     po::variables_map vm;
     if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
       return 0;
@@ -90,15 +74,7 @@ int main(int argc, char** argv) {
     std::cout << "virtual_platform: LMS111 on 127.0.0.1:" << vp.laserPort() << " (CoLa-A), "
               << vp.laserColaBPort() << " (CoLa-B); Aerotech on 127.0.0.1:" << vp.stagePort()
               << std::endl;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-    const auto start = std::chrono::steady_clock::now();
-    while (!g_stop) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      if (duration > 0 &&
-          std::chrono::steady_clock::now() - start > std::chrono::duration<double>(duration))
-        break;
-    }
+    tools::serveUntilStopped(duration);
     vp.stop();
     return 0;
   } catch (const po::error& e) {

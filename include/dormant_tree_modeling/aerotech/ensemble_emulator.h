@@ -22,6 +22,10 @@ struct EmulatedAxisConfig {
   double initial_position = 0.0;  ///< where the axis is at power-up (not homed)
 };
 
+/// @brief The project's stage as emulated: rotary stage "X" (deg, ART310-like: 180 deg/s,
+/// +/-360 deg) and linear slide "Y" (mm, ATS02060-like: 600 mm travel, 200 mm/s).
+std::vector<EmulatedAxisConfig> defaultStageAxes();
+
 /// @brief Failures to show, for tests.
 struct EnsembleFaults {
   std::string fault_axis;        ///< axis whose fault_on_move-th move faults half-way ("" off)
