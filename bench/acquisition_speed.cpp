@@ -7,11 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <deque>
-#include <mutex>
 #include <thread>
 
-#include "dormant_tree_modeling/acquisition/sweep.h"
+#include "dormant_tree_modeling/acquisition/sweep_recorder.h"
 #include "dormant_tree_modeling/aerotech/stage_controller.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/driver.h"
@@ -50,9 +48,7 @@ class Rig {
           const double before = wallClock();
           const double theta = stage_->feedback().rotary;
           const double after = wallClock();
-          std::lock_guard<std::mutex> lock(mutex_);
-          history_.add(0.5 * (before + after), theta * M_PI / 180.0);
-          theta_ = theta;
+          recorder_.addPosition(0.5 * (before + after), theta * M_PI / 180.0);
         } catch (const Error&) {
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(20));  // 50 Hz, as the node
@@ -68,17 +64,13 @@ class Rig {
       acquisition::SweepLine l;
       l.stamp = s.stamp_s;
       l.time_increment = d.time_increment;
-      l.phi0 = d.angle_min + M_PI / 2;
+      l.phi0 = d.angle_min - lms111::DEVICE_TO_ROS_ANGLE_DEG * M_PI / 180.0;
       l.phi_step = d.angle_increment;
       l.ranges = d.ranges;
-      std::lock_guard<std::mutex> lock(mutex_);
-      lines_.push_back(std::move(l));
-      while (lines_.size() > 3000)
-        lines_.pop_front();
-      period_ = d.scan_time;
+      recorder_.addLine(std::move(l), d.scan_time);
     });
     driver_->start();
-    while (period() == 0.0)
+    while (!recorder_.scanPeriod(wallClock(), 1.0))
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ~Rig() {
@@ -87,18 +79,9 @@ class Rig {
     driver_->stop();
   }
 
-  double period() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return period_;
-  }
-
   acquisition::SweepIo io() {
     acquisition::SweepIo io;
     io.now = wallClock;
-    io.rotary_position = [this] {
-      std::lock_guard<std::mutex> lock(mutex_);
-      return theta_;
-    };
     io.move_rotary = [this](double target, double velocity) {
       aerotech::MoveRequest q;
       q.axis = "X";
@@ -108,35 +91,13 @@ class Rig {
       if (!r.success)
         throw Error(ErrorCode::IO_FAILURE, r.message);
     };
-    io.scan_period = [this] { return period(); };
-    io.lines_between = [this](double t0, double t1) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      std::vector<acquisition::SweepLine> out;
-      for (const auto& l : lines_) {
-        if (l.stamp >= t0 && l.stamp <= t1)
-          out.push_back(l);
-      }
-      return out;
+    io.scan_period = [this] {
+      const auto period = recorder_.scanPeriod(wallClock(), 1.0);
+      if (!period)
+        throw Error(ErrorCode::IO_FAILURE, "the laser stopped streaming");
+      return *period;
     };
-    io.first_line_after = [this](double t, double timeout) {
-      const double end = wallClock() + timeout;
-      while (wallClock() < end) {
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          for (const auto& l : lines_) {
-            if (l.stamp > t)
-              return std::optional<acquisition::SweepLine>(l);
-          }
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-      }
-      return std::optional<acquisition::SweepLine>();
-    };
-    io.history = [this] {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      std::lock_guard<std::mutex> lock(mutex_);
-      return history_;
-    };
+    recorder_.bind(io);
     return io;
   }
 
@@ -146,10 +107,7 @@ class Rig {
   std::unique_ptr<lms111::Lms111Driver> driver_;
   std::thread feedback_;
   std::atomic<bool> stop_{false};
-  std::mutex mutex_;
-  std::deque<acquisition::SweepLine> lines_;
-  acquisition::StagePositionHistory history_;
-  double theta_ = 0.0, period_ = 0.0;
+  acquisition::SweepRecorder recorder_;
 };
 
 void BM_View(benchmark::State& state) {

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/laser_scan.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 
 namespace dormant_tree_modeling {
@@ -19,13 +20,11 @@ namespace ros_layer {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-// The LaserScan's angles are the device's minus 90 deg (hardware.md).
-constexpr double ROS_TO_DEVICE_ANGLE = M_PI / 2;
 
 }  // namespace
 
 ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : nh_(nh), tf_listener_(tf_buffer_), history_(0.1) {
+    : nh_(nh), tf_listener_(tf_buffer_) {
   const std::string mode = pnh.param<std::string>("mode", "continuous");
   if (mode != "continuous" && mode != "step")
     throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode);
@@ -43,8 +42,8 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   sweep_.validate();
   tree_distance_ = pnh.param("tree_distance", 1.5);
   max_missing_rows_ = pnh.param("max_missing_rows", 0.05);
-  buffer_s_ = pnh.param("buffer_seconds", 60.0);
-  if (!(tree_distance_ > 0 && buffer_s_ > 10 && max_missing_rows_ >= 0 && max_missing_rows_ < 1))
+  const double buffer_s = pnh.param("buffer_seconds", 60.0);
+  if (!(tree_distance_ > 0 && buffer_s > 10 && max_missing_rows_ >= 0 && max_missing_rows_ < 1))
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "need tree_distance > 0, buffer_seconds > 10 and 0 <= max_missing_rows < 1");
   auto& p = processing_;
@@ -55,6 +54,7 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   p.isolation.hint_sigma = pnh.param("hint_sigma", p.isolation.hint_sigma);
   p.isolation.max_height = pnh.param("max_height", p.isolation.max_height);
   p.validate();
+  recorder_ = std::make_unique<acquisition::SweepRecorder>(buffer_s);
 
   scan_sub_ = nh.subscribe("scan", 200, &ScanAssemblerNode::scanCallback, this);
   joint_sub_ = nh.subscribe("joint_states", 500, &ScanAssemblerNode::jointCallback, this);
@@ -67,36 +67,25 @@ void ScanAssemblerNode::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) 
   acquisition::SweepLine l;
   l.stamp = msg->header.stamp.toSec();
   l.time_increment = msg->time_increment;
-  l.phi0 = msg->angle_min + ROS_TO_DEVICE_ANGLE;
+  l.phi0 = msg->angle_min - lms111::DEVICE_TO_ROS_ANGLE_DEG * DEG;
   l.phi_step = msg->angle_increment;
   l.ranges = msg->ranges;
   l.intensities = msg->intensities;
-  std::lock_guard<std::mutex> lock(mutex_);
-  last_period_ = msg->scan_time;
-  lines_.push_back(std::move(l));
-  while (!lines_.empty() && lines_.back().stamp - lines_.front().stamp > buffer_s_)
-    lines_.pop_front();
+  recorder_->addLine(std::move(l), msg->scan_time);
 }
 
 void ScanAssemblerNode::jointCallback(const sensor_msgs::JointStateConstPtr& msg) {
   for (std::size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i) {
-    if (msg->name[i] == rotary_joint_) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      history_.add(msg->header.stamp.toSec(), msg->position[i]);
-      last_theta_ = msg->position[i];
-    }
+    if (msg->name[i] == rotary_joint_)
+      recorder_->addPosition(msg->header.stamp.toSec(), msg->position[i]);
   }
 }
 
 double ScanAssemblerNode::lastScanPeriod() {
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(3.0);
   while (ros::WallTime::now() < give_up) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (last_period_ > 0 && !lines_.empty() &&
-          ros::Time::now().toSec() - lines_.back().stamp < 1.0)
-        return last_period_;
-    }
+    if (const auto period = recorder_->scanPeriod(ros::Time::now().toSec(), 1.0))
+      return *period;
     ros::WallDuration(0.05).sleep();
   }
   throw Error(ErrorCode::IO_FAILURE, "no scans from the laser on " + scan_sub_.getTopic() +
@@ -118,46 +107,13 @@ void ScanAssemblerNode::moveRotary(double target_deg, double velocity_deg_s) {
   }
 }
 
-std::vector<acquisition::SweepLine> ScanAssemblerNode::linesBetween(double t0, double t1) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<acquisition::SweepLine> out;
-  for (const auto& l : lines_) {
-    if (l.stamp >= t0 && l.stamp <= t1)
-      out.push_back(l);
-  }
-  return out;
-}
-
 std::string ScanAssemblerNode::acquire() {
   const ros::WallTime started = ros::WallTime::now();
   acquisition::SweepIo io;
   io.now = [] { return ros::Time::now().toSec(); };
-  io.rotary_position = [this] {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return last_theta_ / DEG;
-  };
   io.move_rotary = [this](double target, double velocity) { moveRotary(target, velocity); };
   io.scan_period = [this] { return lastScanPeriod(); };
-  io.lines_between = [this](double t0, double t1) { return linesBetween(t0, t1); };
-  io.first_line_after = [this](double t, double timeout) {
-    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (ros::WallTime::now() < give_up) {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (const auto& l : lines_) {
-          if (l.stamp > t)
-            return std::optional<acquisition::SweepLine>(l);
-        }
-      }
-      ros::WallDuration(0.002).sleep();
-    }
-    return std::optional<acquisition::SweepLine>();
-  };
-  io.history = [this] {
-    ros::WallDuration(0.05).sleep();  // the joint states of the sweep's last moments
-    std::lock_guard<std::mutex> lock(mutex_);
-    return history_;
-  };
+  recorder_->bind(io);
   std::size_t dropped = 0, missing = 0;
   acquisition::RangeImage image = acquisition::runSweep(io, sweep_, &dropped, &missing);
   // A laser that dropped out mid-sweep leaves empty rows: fail the view so it is retried.

@@ -62,5 +62,14 @@ Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed) {
   return orchard;
 }
 
+Scene sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
+                            std::uint64_t seed) {
+  if (!scene_path.empty())
+    return loadScene(scene_path);
+  OrchardConfig orchard;
+  orchard.preset = preset;
+  return generateOrchard(orchard, seed).scene;
+}
+
 }  // namespace simulation
 }  // namespace dormant_tree_modeling

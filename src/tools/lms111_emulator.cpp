@@ -74,14 +74,7 @@ int main(int argc, char** argv) {
       source = std::make_shared<lms111::RecordedScanSource>(
           lms111::RecordedScanSource::fromFile(telegram));
     } else {
-      simulation::Scene scene;
-      if (!scene_path.empty()) {
-        scene = simulation::loadScene(scene_path);
-      } else {
-        simulation::OrchardConfig orchard;
-        orchard.preset = preset;
-        scene = simulation::generateOrchard(orchard, seed).scene;
-      }
+      const simulation::Scene scene = simulation::sceneFromFileOrPreset(scene_path, preset, seed);
       simulation::Lms111Config sensor;
       sensor.range_noise_sigma = noise_mm / 1000.0;
       const Eigen::Isometry3d pose = lms111::SimulatedScanSource::frontView(distance, height);

@@ -53,14 +53,7 @@ int main(int argc, char** argv) {
     if (platform.size() != 4)
       throw Error(ErrorCode::INVALID_ARGUMENT, "--platform takes x y z yaw_deg");
 
-    simulation::Scene scene;
-    if (!scene_path.empty()) {
-      scene = simulation::loadScene(scene_path);
-    } else {
-      simulation::OrchardConfig orchard;
-      orchard.preset = preset;
-      scene = simulation::generateOrchard(orchard, seed).scene;
-    }
+    const simulation::Scene scene = simulation::sceneFromFileOrPreset(scene_path, preset, seed);
     simulation::VirtualPlatformOptions o;
     o.laser = lms;
     o.stage_port = aerotech_port;

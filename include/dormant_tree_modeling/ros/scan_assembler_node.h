@@ -7,11 +7,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <deque>
+#include <memory>
 #include <mutex>
 
-#include "dormant_tree_modeling/acquisition/sweep.h"
-#include "dormant_tree_modeling/acquisition/sweep_assembler.h"
+#include "dormant_tree_modeling/acquisition/sweep_recorder.h"
 #include "dormant_tree_modeling/acquisition/view_processing.h"
 
 namespace dormant_tree_modeling {
@@ -40,12 +39,11 @@ class ScanAssemblerNode {
   /// Runs the sweep; returns a summary or throws Error.
   std::string acquire();
   void moveRotary(double target_deg, double velocity_deg_s);
-  std::vector<acquisition::SweepLine> linesBetween(double t0, double t1);
   double lastScanPeriod();
 
   std::string rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_;
   acquisition::SweepSettings sweep_;
-  double tree_distance_, buffer_s_, max_missing_rows_;
+  double tree_distance_, max_missing_rows_;
   acquisition::ViewProcessingConfig processing_;
 
   ros::NodeHandle nh_;
@@ -55,12 +53,8 @@ class ScanAssemblerNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
 
-  std::mutex mutex_;  // the buffers below
-  std::deque<acquisition::SweepLine> lines_;
-  acquisition::StagePositionHistory history_;
-  double last_period_ = 0.0;
-  double last_theta_ = 0.0;   // rad, latest rotary joint position
-  std::mutex acquire_mutex_;  // one sweep at a time
+  std::unique_ptr<acquisition::SweepRecorder> recorder_;  // scans and stage positions
+  std::mutex acquire_mutex_;                              // one sweep at a time
 };
 
 }  // namespace ros_layer

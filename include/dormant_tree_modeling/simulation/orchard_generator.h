@@ -39,5 +39,11 @@ struct Orchard {
 /// @throws Error INVALID_ARGUMENT for an unknown preset or inconsistent spacing
 Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed);
 
+/// @brief The scene of a scene file (saveScene) when a path is given, else the default orchard
+/// of the preset and seed: what the emulators scan.
+/// @throws Error FILE_NOT_FOUND, PARSE_ERROR, INVALID_ARGUMENT
+Scene sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
+                            std::uint64_t seed);
+
 }  // namespace simulation
 }  // namespace dormant_tree_modeling
