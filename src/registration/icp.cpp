@@ -7,7 +7,6 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
-#include "dormant_tree_modeling/modeling/preprocess.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
@@ -16,31 +15,19 @@ namespace {
 
 constexpr double DEG = M_PI / 180.0;
 
-// Unit normals of every point by PCA of its k nearest neighbours (zero where undefined).
-std::vector<Eigen::Vector3d> normals(const Points& pts, const modeling::PointIndex& index, int k) {
-  std::vector<Eigen::Vector3d> n(pts.size(), Eigen::Vector3d::Zero());
-  parallelFor(static_cast<int>(pts.size()), [&](int i) {
-    const auto nn = index.nearest(pts[i], k);
-    if (nn.size() < 5)
-      return;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const int j : nn)
-      mean += pts[j];
-    mean /= static_cast<double>(nn.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const int j : nn)
-      cov += (pts[j] - mean) * (pts[j] - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
-    n[i] = es.eigenvectors().col(0);
-  });
-  return n;
-}
-
 struct Match {
   int source, target;
-  double residual;  // signed point-to-plane distance
-  double distance;  // point-to-point distance
+  double residual;  // signed point-to-plane distance, or the point-to-ray distance
+  bool across;      // seen from opposite sides: point-to-ray
 };
+
+// Two unit vectors spanning the plane normal to d.
+void planeBasis(const Eigen::Vector3d& d, Eigen::Vector3d& u, Eigen::Vector3d& v) {
+  const Eigen::Vector3d a =
+      std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  u = d.cross(a).normalized();
+  v = d.cross(u);
+}
 
 }  // namespace
 
@@ -57,39 +44,52 @@ void IcpConfig::validate() const {
   require(trim > 0 && trim <= 1, "trim must be in (0, 1]");
   require(huber > 0, "huber must be > 0");
   require(normal_neighbors >= 5, "normal_neighbors must be >= 5");
+  require(across_cos >= -1 && across_cos <= 1, "across_cos must be in [-1, 1]");
   require(min_rotation_step > 0 && min_translation_step > 0, "convergence steps must be > 0");
 }
 
-IcpResult alignPointToPlane(const Points& source_in, const Points& target_in,
-                            const Eigen::Isometry3d& guess, const IcpConfig& c) {
+IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
+                        const Eigen::Isometry3d& guess, const IcpConfig& c, int first_level,
+                        int last_level) {
   c.validate();
-  if (source_in.size() < 10 || target_in.size() < 10)
-    throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
+  const int levels = static_cast<int>(c.voxels.size());
+  if (source_p.levels.size() != c.voxels.size() || target_p.levels.size() != c.voxels.size())
+    throw Error(ErrorCode::INVALID_ARGUMENT, "ICP: pyramids do not match the configured levels");
+  if (last_level < 0 || last_level >= levels)
+    last_level = levels - 1;
+  first_level = std::clamp(first_level, 0, last_level);
   IcpResult r;
   r.transform = guess;
-  for (std::size_t level = 0; level < c.voxels.size(); ++level) {
-    const double voxel = c.voxels[level];
-    const Points source = modeling::voxelDownsample(source_in, voxel);
-    const Points target = modeling::voxelDownsample(target_in, voxel);
-    const modeling::PointIndex index(target);
-    const auto target_normals = normals(target, index, c.normal_neighbors);
-    const double limit = c.distance_factor * voxel;
-    const bool finest = level + 1 == c.voxels.size();
+  for (int level = first_level; level <= last_level; ++level) {
+    const Surface& source = source_p.levels[level];
+    const Surface& target = target_p.levels[level];
+    if (source.size() < 10 || target.size() < 10)
+      throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
+    const modeling::PointIndex index(target.points);
+    const double limit = c.distance_factor * c.voxels[level];
     std::vector<Match> matches(source.size());
     std::vector<char> valid(source.size());
+    r.converged = false;
     for (int it = 0; it < c.max_iterations; ++it) {
       ++r.iterations;
+      const Eigen::Matrix3d rot = r.transform.linear();
       parallelFor(static_cast<int>(source.size()), [&](int i) {
-        const Eigen::Vector3d p = r.transform * source[i];
-        const auto nn = index.nearest(p, 1);
         valid[i] = 0;
-        if (nn.empty() || target_normals[nn[0]].isZero())
+        const Eigen::Vector3d p = r.transform * source.points[i];
+        const auto nn = index.nearest(p, 1);
+        if (nn.empty())
           return;
-        const Eigen::Vector3d d = p - target[nn[0]];
-        const double dist = d.norm();
-        if (dist > limit)
+        const int j = nn[0];
+        const Eigen::Vector3d& n = target.normals[j];
+        if (n.isZero())
           return;
-        matches[i] = {i, nn[0], d.dot(target_normals[nn[0]]), dist};
+        const Eigen::Vector3d d = p - target.points[j];
+        if (d.squaredNorm() > limit * limit)
+          return;
+        const Eigen::Vector3d& vt = target.view_dirs[j];
+        const bool across = !vt.isZero() && !source.view_dirs[i].isZero() &&
+                            (rot * source.view_dirs[i]).dot(vt) < c.across_cos;
+        matches[i] = {i, j, across ? (d - d.dot(vt) * vt).norm() : d.dot(n), across};
         valid[i] = 1;
       });
       std::vector<Match> used;
@@ -110,19 +110,46 @@ IcpResult alignPointToPlane(const Points& source_in, const Points& target_in,
       // Linearised point-to-plane step (small rotation w, translation t), Huber-weighted.
       Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
       Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
-      double sq = 0;
+      // Rotations about the matched points' centroid keep the two halves of the system on
+      // one scale (the conditioning measure needs that).
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (const auto& m : used)
+        centre += r.transform * source.points[m.source];
+      centre /= static_cast<double>(used.size());
+      double sq = 0, radius_sq = 0;
       for (const auto& m : used) {
-        const Eigen::Vector3d p = r.transform * source[m.source];
-        const Eigen::Vector3d& n = target_normals[m.target];
-        Eigen::Matrix<double, 6, 1> J;
-        J << p.cross(n), n;
-        const double e = m.residual;
-        const double w = std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
-        A += w * J * J.transpose();
-        b -= w * J * e;
-        sq += e * e;
+        const Eigen::Vector3d p = r.transform * source.points[m.source] - centre;
+        radius_sq += p.squaredNorm();
+        const double w = std::abs(m.residual) <= c.huber ? 1.0 : c.huber / std::abs(m.residual);
+        sq += m.residual * m.residual;
+        auto addRow = [&](const Eigen::Vector3d& n, double e) {
+          Eigen::Matrix<double, 6, 1> J;
+          J << p.cross(n), n;
+          A += w * J * J.transpose();
+          b -= w * J * e;
+        };
+        if (!m.across) {
+          addRow(target.normals[m.target], m.residual);
+          continue;
+        }
+        // Seen from opposite sides, the two points lie on opposite halves of a branch: only
+        // the offset across the target's ray says how far apart the branch axes are.
+        Eigen::Vector3d u, v;
+        planeBasis(target.view_dirs[m.target], u, v);
+        const Eigen::Vector3d d = r.transform * source.points[m.source] - target.points[m.target];
+        addRow(u, d.dot(u));
+        addRow(v, d.dot(v));
       }
       r.rmse = std::sqrt(sq / used.size());
+      {
+        // Rotation rows scaled by the cloud's radius so both blocks are lengths.
+        const double scale = std::sqrt(radius_sq / used.size());
+        Eigen::Matrix<double, 6, 1> s;
+        s << Eigen::Vector3d::Constant(1.0 / std::max(scale, 1e-6)), Eigen::Vector3d::Ones();
+        const Eigen::Matrix<double, 6, 6> An = s.asDiagonal() * A * s.asDiagonal();
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(An);
+        r.conditioning = es.eigenvalues()(0) / std::max(es.eigenvalues()(5), 1e-12);
+      }
       const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
       if (!x.allFinite())
         break;
@@ -130,16 +157,24 @@ IcpResult alignPointToPlane(const Points& source_in, const Points& target_in,
       const double angle = x.head<3>().norm();
       if (angle > 0)
         step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-      step.translation() = x.tail<3>();
+      step.translation() = centre - step.linear() * centre + x.tail<3>();
       r.transform = step * r.transform;
       if (angle < c.min_rotation_step * DEG && x.tail<3>().norm() < c.min_translation_step) {
-        if (finest)
-          r.converged = true;
+        r.converged = true;
         break;
       }
     }
   }
   return r;
+}
+
+IcpResult alignPointToPlane(const Points& source, const Points& target,
+                            const Eigen::Isometry3d& guess, const IcpConfig& c) {
+  c.validate();
+  if (source.size() < 10 || target.size() < 10)
+    throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
+  return alignPyramids(makePyramid(source, {}, c.voxels, c.normal_neighbors),
+                       makePyramid(target, {}, c.voxels, c.normal_neighbors), guess, c);
 }
 
 }  // namespace registration

@@ -3,12 +3,10 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/registration/surface.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
-
-using modeling::Points;
 
 /// @brief Point-to-plane ICP, coarse to fine. Lengths in m, angles in degrees.
 struct IcpConfig {
@@ -16,10 +14,15 @@ struct IcpConfig {
   /// distance_factor x its voxel (a wide basin first, a tight fit last).
   std::vector<double> voxels = {0.04, 0.02, 0.01};
   double distance_factor = 4.0;
-  int max_iterations = 30;             ///< per level
-  double trim = 0.8;                   ///< share of the closest correspondences used
-  double huber = 0.01;                 ///< m: residuals beyond count linearly (robust to clutter)
-  int normal_neighbors = 12;           ///< k for the target's PCA normals
+  int max_iterations = 30;    ///< per level
+  double trim = 0.8;          ///< share of the closest correspondences used
+  double huber = 0.01;        ///< m: residuals beyond count linearly (robust to clutter)
+  int normal_neighbors = 12;  ///< k for the PCA normals
+  /// Points whose view directions (towards their sensors) meet below this cosine were seen
+  /// from opposite sides: they lie on opposite halves of a branch, a diameter apart along the
+  /// ray, so such a pair only counts its offset across the target point's ray (point-to-ray).
+  /// Point-to-plane on them would pull the back of the tree into the front by ~1.3 radii.
+  double across_cos = -0.3;
   double min_rotation_step = 0.005;    ///< deg: converged below both steps
   double min_translation_step = 1e-4;  ///< m
   /// @throws Error INVALID_ARGUMENT naming the bad field
@@ -29,14 +32,25 @@ struct IcpConfig {
 /// @brief Result of one alignment.
 struct IcpResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  ///< source -> target
-  double rmse = 0;  ///< m, over the used correspondences at the finest level
-  double overlap =
-      0;  ///< share of source points (finest level) with a target point within its limit
+  double rmse = 0;         ///< m, point-to-plane, over the used pairs of the last level run
+  double overlap = 0;      ///< share of source points (last level) with a target point in the limit
   int iterations = 0;      ///< over all levels
-  bool converged = false;  ///< the finest level converged before max_iterations
+  bool converged = false;  ///< the last level converged before max_iterations
+  /// Smallest eigenvalue of the normalised point-to-plane information (1 = every direction
+  /// equally constrained, 0 = a direction the surfaces leave free, e.g. sliding along a trunk).
+  double conditioning = 0;
 };
 
-/// @brief Align source to target from an initial guess (source -> target).
+/// @brief Align source to target, both pyramids with the config's voxel sizes.
+/// @param guess initial source -> target transform
+/// @param first_level skip the coarser levels (refinement from a good guess)
+/// @param last_level stop after this level (-1: the finest; quick scoring of candidates)
+/// @throws Error EMPTY_INPUT when a level holds fewer than 10 points or nothing overlaps
+IcpResult alignPyramids(const Pyramid& source, const Pyramid& target,
+                        const Eigen::Isometry3d& guess, const IcpConfig& config,
+                        int first_level = 0, int last_level = -1);
+
+/// @brief Align plain point sets (unoriented normals).
 /// @throws Error EMPTY_INPUT when either cloud has fewer than 10 points
 IcpResult alignPointToPlane(const Points& source, const Points& target,
                             const Eigen::Isometry3d& guess, const IcpConfig& config = {});

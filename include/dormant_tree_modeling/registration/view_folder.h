@@ -1,0 +1,63 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/registration/multi_view.h"
+
+namespace dormant_tree_modeling {
+namespace registration {
+
+/// @brief How a folder of views is read.
+struct ViewFolderOptions {
+  /// Keep only points within this horizontal distance (m) of where the view's guess expects
+  /// the tree (the simulation tool writes whole views; the rows beyond only cost time). The
+  /// guess may be 0.5 m off, hence a wide crop; <= 0 keeps everything.
+  double crop_radius = 1.2;
+  /// m: without a guess the tree is this far ahead (+x) of the view's origin, somewhere
+  /// along the slide; the crop then only bounds the distance ahead.
+  double standoff = 1.5;
+  /// Use the guessed platform poses for the crop, the ground and as registration hints (the
+  /// slide moves within a station are used either way: they are exact).
+  bool use_guesses = true;
+  /// Drop points less than this (m) above the ground: the ground is a plane that any wrong
+  /// heading still overlays, so it would hide bad fits from the overlap check. The ground lies
+  /// the guess's height below the view's origin; without a guess, at the lowest 2 cm level
+  /// holding 5 % of the points. < 0 keeps the ground.
+  double ground_margin = 0.1;
+};
+
+/// @brief A folder of views: views.json (format dormant_tree_views/1, evaluation.md) and
+/// views/<name>.pcd in each view's frame.
+struct ViewFolder {
+  std::vector<ViewInput> views;
+  /// Per view, from views.json when present: the true pose and the guess (view -> world).
+  std::vector<std::optional<Eigen::Isometry3d>> true_poses, guess_poses;
+};
+
+/// @brief Read a folder of views. Views sharing a platform_index form a station; their poses
+/// within it come from the guesses (the slide moves are exact; only the platform is off).
+/// @throws Error FILE_NOT_FOUND, PARSE_ERROR naming the file
+ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& options = {});
+
+/// @brief Pose errors of the registered views against the truth, relative to the first view.
+struct PoseErrors {
+  int views = 0;  ///< registered views with a true pose
+  double median_mm = 0, max_mm = 0, median_deg = 0, max_deg = 0;
+};
+
+/// @brief Compare registered poses with true ones (both taken relative to the first view).
+PoseErrors poseErrors(const RegistrationResult& result,
+                      const std::vector<std::optional<Eigen::Isometry3d>>& true_poses);
+
+/// @brief Per-view poses and figures as JSON (format dormant_tree_registration/1).
+std::string registrationToJson(const RegistrationResult& result);
+
+/// @brief A Markdown report: one row per view, the stations left out and why.
+std::string registrationReport(const RegistrationResult& result,
+                               const std::optional<PoseErrors>& errors);
+
+}  // namespace registration
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,64 @@
+#include "dormant_tree_modeling/common/yaml_map.h"
+#include "dormant_tree_modeling/registration/multi_view.h"
+
+namespace dormant_tree_modeling {
+namespace registration {
+
+RegistrationConfig loadRegistrationConfig(const std::string& path) {
+  RegistrationConfig c;
+  forEachYamlEntry(path, "registration", "registration parameter",
+                   [&c](const std::string& key, const YAML::Node& v) {
+                     if (key == "icp_voxels")
+                       c.icp.voxels = v.as<std::vector<double>>();
+                     else if (key == "icp_distance_factor")
+                       c.icp.distance_factor = v.as<double>();
+                     else if (key == "icp_max_iterations")
+                       c.icp.max_iterations = v.as<int>();
+                     else if (key == "icp_trim")
+                       c.icp.trim = v.as<double>();
+                     else if (key == "icp_huber")
+                       c.icp.huber = v.as<double>();
+                     else if (key == "icp_normal_neighbors")
+                       c.icp.normal_neighbors = v.as<int>();
+                     else if (key == "icp_across_cos")
+                       c.icp.across_cos = v.as<double>();
+                     else if (key == "coarse_cell")
+                       c.coarse.cell = v.as<double>();
+                     else if (key == "coarse_yaw_window_deg")
+                       c.coarse.yaw_window_deg = v.as<double>();
+                     else if (key == "coarse_yaw_step_deg")
+                       c.coarse.yaw_step_deg = v.as<double>();
+                     else if (key == "coarse_xy_window")
+                       c.coarse.xy_window = v.as<double>();
+                     else if (key == "coarse_z_window")
+                       c.coarse.z_window = v.as<double>();
+                     else if (key == "coarse_z_window_unhinted")
+                       c.coarse.z_window_unhinted = v.as<double>();
+                     else if (key == "coarse_z_step")
+                       c.coarse.z_step = v.as<double>();
+                     else if (key == "coarse_candidates")
+                       c.coarse.candidates = v.as<int>();
+                     else if (key == "candidate_levels")
+                       c.candidate_levels = v.as<int>();
+                     else if (key == "refinement_rounds")
+                       c.refinement_rounds = v.as<int>();
+                     else if (key == "min_points")
+                       c.min_points = v.as<std::size_t>();
+                     else if (key == "min_overlap")
+                       c.min_overlap = v.as<double>();
+                     else if (key == "max_rmse")
+                       c.max_rmse = v.as<double>();
+                     else if (key == "use_hints")
+                       c.use_hints = v.as<bool>();
+                     else if (key == "threads")
+                       c.threads = v.as<int>();
+                     else
+                       return false;
+                     return true;
+                   });
+  c.validate();
+  return c;
+}
+
+}  // namespace registration
+}  // namespace dormant_tree_modeling

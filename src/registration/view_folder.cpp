@@ -1,0 +1,218 @@
+#include "dormant_tree_modeling/registration/view_folder.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/io/tree_json.h"
+
+namespace dormant_tree_modeling {
+namespace registration {
+
+namespace {
+
+std::optional<Eigen::Isometry3d> poseFrom(const nlohmann::json& v, const char* key) {
+  if (!v.contains(key))
+    return std::nullopt;
+  const auto& p = v.at(key);
+  const auto t = p.at("translation").get<std::vector<double>>();
+  const auto q = p.at("rotation_xyzw").get<std::vector<double>>();
+  if (t.size() != 3 || q.size() != 4)
+    throw Error(ErrorCode::PARSE_ERROR, std::string(key) + " needs 3 + 4 numbers");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return pose;
+}
+
+nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+}
+
+// The ground's height in a view without a guess: the lowest 2 cm level holding 5 % of the
+// points, or none.
+std::optional<double> lowestDenseLevel(const Points& pts) {
+  constexpr double BIN = 0.02;
+  if (pts.empty())
+    return std::nullopt;
+  double lowest = INFINITY;
+  for (const auto& p : pts)
+    lowest = std::min(lowest, p.z());
+  std::map<long, std::size_t> bins;
+  for (const auto& p : pts)
+    ++bins[static_cast<long>((p.z() - lowest) / BIN)];
+  for (const auto& [bin, n] : bins) {
+    if (n >= 0.05 * pts.size())
+      return lowest + (bin + 1) * BIN;
+  }
+  return std::nullopt;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty())
+    return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& options) {
+  const std::string index_path = dir + "/views.json";
+  if (!std::filesystem::exists(index_path))
+    throw Error(ErrorCode::FILE_NOT_FOUND, index_path + " does not exist (not a folder of views)");
+  ViewFolder f;
+  try {
+    const auto doc = nlohmann::json::parse(io::readTextFile(index_path));
+    std::map<int, Eigen::Isometry3d> station_frame;  // first view's guess per station
+    for (const auto& v : doc.at("views")) {
+      ViewInput in;
+      in.name = v.at("name").get<std::string>();
+      in.station = v.value("platform_index", v.value("index", 0));
+      const auto truth = poseFrom(v, "true_pose");
+      const auto guess = poseFrom(v, "guess_pose");
+      f.true_poses.push_back(truth);
+      f.guess_poses.push_back(guess);
+      if (guess) {
+        const auto [it, fresh] = station_frame.emplace(in.station, *guess);
+        in.in_station = it->second.inverse() * *guess;
+        if (options.use_guesses)
+          in.station_hint = it->second;
+      }
+      const bool guided = guess && options.use_guesses;
+      const std::string cloud_path = dir + "/views/" + in.name + ".pcd";
+      io::CloudReadOptions ro;
+      ro.allow_empty = true;
+      ro.recenter_threshold = INFINITY;
+      const auto cloud = io::readCloud(cloud_path, ro).cloud;
+      // The tree is where the guess expects it (the world origin); without a guess, at the
+      // plan's standoff ahead, anywhere along the slide.
+      const Eigen::Vector2d expected =
+          guided ? Eigen::Vector2d(guess->inverse().translation().head<2>())
+                 : Eigen::Vector2d(options.standoff, 0.0);
+      for (const auto& p : cloud->points) {
+        const Eigen::Vector3d q = p.getVector3fMap().cast<double>();
+        const double off =
+            guided ? (q.head<2>() - expected).norm() : std::abs(q.x() - expected.x());
+        if (q.allFinite() && (options.crop_radius <= 0 || off <= options.crop_radius))
+          in.points.push_back(q);
+      }
+      if (options.ground_margin >= 0) {
+        const std::optional<double> ground =
+            guided ? std::optional<double>(-guess->translation().z()) : lowestDenseLevel(in.points);
+        if (ground) {
+          const double floor = *ground + options.ground_margin;
+          in.points.erase(
+              std::remove_if(in.points.begin(), in.points.end(),
+                             [floor](const Eigen::Vector3d& q) { return q.z() < floor; }),
+              in.points.end());
+        }
+      }
+      f.views.push_back(std::move(in));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(ErrorCode::PARSE_ERROR, index_path + ": " + e.what());
+  }
+  return f;
+}
+
+PoseErrors poseErrors(const RegistrationResult& result,
+                      const std::vector<std::optional<Eigen::Isometry3d>>& true_poses) {
+  PoseErrors e;
+  int first = -1;
+  for (std::size_t i = 0; i < result.views.size() && first < 0; ++i) {
+    if (result.views[i].registered && i < true_poses.size() && true_poses[i])
+      first = static_cast<int>(i);
+  }
+  if (first < 0)
+    return e;
+  // The result's frame is the first registered view's; so is the truth, once made relative.
+  const Eigen::Isometry3d world_to_first = true_poses[first]->inverse();
+  const Eigen::Isometry3d result_first_inv = result.views[first].pose.inverse();
+  std::vector<double> dt, da;
+  for (std::size_t i = 0; i < result.views.size(); ++i) {
+    if (!result.views[i].registered || i >= true_poses.size() || !true_poses[i])
+      continue;
+    const Eigen::Isometry3d truth = world_to_first * *true_poses[i];
+    const Eigen::Isometry3d got = result_first_inv * result.views[i].pose;
+    const Eigen::Isometry3d d = truth.inverse() * got;
+    dt.push_back((got.translation() - truth.translation()).norm() * 1000);
+    da.push_back(Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
+  }
+  e.views = static_cast<int>(dt.size());
+  e.median_mm = median(dt);
+  e.median_deg = median(da);
+  e.max_mm = *std::max_element(dt.begin(), dt.end());
+  e.max_deg = *std::max_element(da.begin(), da.end());
+  return e;
+}
+
+std::string registrationToJson(const RegistrationResult& r) {
+  nlohmann::json views = nlohmann::json::array();
+  for (const auto& v : r.views) {
+    views.push_back({{"name", v.name},
+                     {"station", v.station},
+                     {"registered", v.registered},
+                     {"pose", poseJson(v.pose)},
+                     {"rmse_m", v.rmse},
+                     {"overlap", v.overlap},
+                     {"confidence", v.confidence},
+                     {"reason", v.reason}});
+  }
+  return nlohmann::json{{"format", "dormant_tree_registration/1"},
+                        {"frame", "the first registered view's frame"},
+                        {"stations", r.stations},
+                        {"stations_registered", r.stations_registered},
+                        {"seconds", r.seconds},
+                        {"seconds_prepare", r.seconds_prepare},
+                        {"seconds_placement", r.seconds_placement},
+                        {"seconds_refinement", r.seconds_refinement},
+                        {"views", views}}
+             .dump(1) +
+         "\n";
+}
+
+std::string registrationReport(const RegistrationResult& r,
+                               const std::optional<PoseErrors>& errors) {
+  std::ostringstream s;
+  s << std::fixed;
+  int registered = 0;
+  for (const auto& v : r.views)
+    registered += v.registered;
+  s << "# Registration\n\n"
+    << registered << " of " << r.views.size() << " views registered (" << r.stations_registered
+    << " of " << r.stations << " platform positions) in " << std::setprecision(1) << r.seconds
+    << " s (preparation " << r.seconds_prepare << " s, placement " << r.seconds_placement
+    << " s, joint refinement " << r.seconds_refinement
+    << " s), into the frame of the first view.\n\n";
+  if (errors && errors->views > 0) {
+    s << "Against the true poses (" << errors->views << " views): " << std::setprecision(1)
+      << "median " << errors->median_mm << " mm / " << std::setprecision(3) << errors->median_deg
+      << " deg, max " << std::setprecision(1) << errors->max_mm << " mm / " << std::setprecision(3)
+      << errors->max_deg << " deg.\n\n";
+  }
+  s << "| view | station | registered | x m | y m | z m | yaw deg | rmse mm | overlap | "
+       "confidence | note |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& v : r.views) {
+    const Eigen::Vector3d t = v.pose.translation();
+    const double yaw = std::atan2(v.pose.linear()(1, 0), v.pose.linear()(0, 0)) * 180 / M_PI;
+    s << "| " << v.name << " | " << v.station << " | " << (v.registered ? "yes" : "**no**") << " | "
+      << std::setprecision(3) << t.x() << " | " << t.y() << " | " << t.z() << " | "
+      << std::setprecision(2) << yaw << " | " << std::setprecision(1) << v.rmse * 1000 << " | "
+      << std::setprecision(2) << v.overlap << " | " << v.confidence << " | " << v.reason << " |\n";
+  }
+  return s.str();
+}
+
+}  // namespace registration
+}  // namespace dormant_tree_modeling
