@@ -1,8 +1,13 @@
 #include "dormant_tree_modeling/modeling/point_index.h"
 
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
+#include <array>
+
+// FLANN's kd-tree directly: PCL's KdTreeFLANN sends every single query through FLANN's
+// batch search, which opens an OpenMP region per query; called from our worker threads
+// that cost more in futex calls than the search itself (6 M calls for one registration).
+#include <flann/algorithms/dist.h>
+#include <flann/algorithms/kdtree_single_index.h>
+#include <flann/util/result_set.h>
 
 #include <algorithm>
 
@@ -10,18 +15,29 @@ namespace dormant_tree_modeling {
 namespace modeling {
 
 struct PointIndex::Impl {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud{new pcl::PointCloud<pcl::PointXYZ>};
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree{false};  // unsorted radius results: faster
+  std::vector<float> data;  // x y z per point, referenced by the index
+  std::unique_ptr<flann::KDTreeSingleIndex<flann::L2_Simple<float>>> tree;
+  flann::SearchParams params{flann::FLANN_CHECKS_UNLIMITED, 0.0f, false};
+
+  std::array<float, 3> query(const Eigen::Vector3d& q) const {
+    return {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())};
+  }
 };
 
 PointIndex::PointIndex(const Points& pts) : impl_(new Impl), size_(pts.size()) {
-  impl_->cloud->reserve(pts.size());
+  impl_->data.reserve(3 * pts.size());
   for (const auto& p : pts) {
-    impl_->cloud->push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                                          static_cast<float>(p.z())));
+    impl_->data.push_back(static_cast<float>(p.x()));
+    impl_->data.push_back(static_cast<float>(p.y()));
+    impl_->data.push_back(static_cast<float>(p.z()));
   }
-  if (!pts.empty())
-    impl_->tree.setInputCloud(impl_->cloud);
+  if (!pts.empty()) {
+    const flann::Matrix<float> m(impl_->data.data(), pts.size(), 3);
+    // Leaves of 15 points, as PCL builds it; reordering copies the data into tree order.
+    impl_->tree = std::make_unique<flann::KDTreeSingleIndex<flann::L2_Simple<float>>>(
+        m, flann::KDTreeSingleIndexParams(15));
+    impl_->tree->buildIndex();
+  }
 }
 
 PointIndex::~PointIndex() = default;
@@ -30,32 +46,56 @@ std::vector<int> PointIndex::nearest(const Eigen::Vector3d& q, int k) const {
   std::vector<int> idx;
   if (size_ == 0 || k <= 0)
     return idx;
-  std::vector<float> d;
-  const pcl::PointXYZ p(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                        static_cast<float>(q.z()));
-  impl_->tree.nearestKSearch(p, std::min<int>(k, static_cast<int>(size_)), idx, d);
+  k = std::min<int>(k, static_cast<int>(size_));
+  flann::KNNSimpleResultSet<float> result(static_cast<std::size_t>(k));
+  const auto v = impl_->query(q);
+  impl_->tree->findNeighbors(result, v.data(), impl_->params);
+  std::vector<std::size_t> found(result.size());
+  std::vector<float> dist(result.size());
+  result.copy(found.data(), dist.data(), found.size(), true);
+  idx.assign(found.begin(), found.end());
   return idx;
+}
+
+int PointIndex::nearestOne(const Eigen::Vector3d& q, float* squared_distance) const {
+  if (size_ == 0)
+    return -1;
+  flann::KNNSimpleResultSet<float> result(1);
+  const auto v = impl_->query(q);
+  impl_->tree->findNeighbors(result, v.data(), impl_->params);
+  if (result.size() < 1)
+    return -1;
+  std::size_t i = 0;
+  float d = 0;
+  result.copy(&i, &d, 1, false);
+  if (squared_distance)
+    *squared_distance = d;
+  return static_cast<int>(i);
 }
 
 std::vector<int> PointIndex::within(const Eigen::Vector3d& q, double radius) const {
   std::vector<int> idx;
   if (size_ == 0)
     return idx;
-  std::vector<float> d;
-  const pcl::PointXYZ p(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                        static_cast<float>(q.z()));
-  impl_->tree.radiusSearch(p, radius, idx, d);
+  flann::RadiusResultSet<float> result(static_cast<float>(radius * radius));
+  const auto v = impl_->query(q);
+  impl_->tree->findNeighbors(result, v.data(), impl_->params);
+  std::vector<std::size_t> found(result.size());
+  std::vector<float> dist(result.size());
+  if (!found.empty())
+    result.copy(found.data(), dist.data(), found.size(), false);
+  idx.assign(found.begin(), found.end());
   return idx;
 }
 
 int PointIndex::countWithin(const Eigen::Vector3d& q, double radius, int limit) const {
-  if (size_ == 0)
+  if (size_ == 0 || limit <= 0)
     return 0;
-  std::vector<int> idx;
-  std::vector<float> d;
-  const pcl::PointXYZ p(static_cast<float>(q.x()), static_cast<float>(q.y()),
-                        static_cast<float>(q.z()));
-  return impl_->tree.radiusSearch(p, radius, idx, d, static_cast<unsigned int>(limit));
+  flann::KNNRadiusResultSet<float> result(static_cast<float>(radius * radius),
+                                          static_cast<std::size_t>(limit));
+  const auto v = impl_->query(q);
+  impl_->tree->findNeighbors(result, v.data(), impl_->params);
+  return static_cast<int>(result.size());
 }
 
 std::vector<std::vector<int>> euclideanClusters(const Points& pts, double tolerance, int min_size,

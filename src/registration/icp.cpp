@@ -61,7 +61,9 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
   IcpResult r;
   r.transform = guess;
   for (int level = first_level; level <= last_level; ++level) {
-    const Surface& source = source_p.levels[level];
+    // The source one level coarser than the target: a sparser source costs fewer searches and
+    // its averaged points are less noisy; the dense target keeps the planes sharp.
+    const Surface& source = source_p.levels[std::max(level - 1, 0)];
     const Surface& target = target_p.levels[level];
     if (source.size() < 10 || target.size() < 10)
       throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
@@ -70,16 +72,16 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
     std::vector<Match> matches(source.size());
     std::vector<char> valid(source.size());
     r.converged = false;
+    int small_steps = 0;
     for (int it = 0; it < c.max_iterations; ++it) {
       ++r.iterations;
       const Eigen::Matrix3d rot = r.transform.linear();
       parallelFor(static_cast<int>(source.size()), [&](int i) {
         valid[i] = 0;
         const Eigen::Vector3d p = r.transform * source.points[i];
-        const auto nn = index.nearest(p, 1);
-        if (nn.empty())
+        const int j = index.nearestOne(p);
+        if (j < 0)
           return;
-        const int j = nn[0];
         const Eigen::Vector3d& n = target.normals[j];
         if (n.isZero())
           return;
@@ -159,7 +161,20 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
         step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
       step.translation() = centre - step.linear() * centre + x.tail<3>();
       r.transform = step * r.transform;
-      if (angle < c.min_rotation_step * DEG && x.tail<3>().norm() < c.min_translation_step) {
+      // Coarse levels only have to hand over to the next: their steps scale with the voxel.
+      const double scale = c.voxels[level] / c.voxels.back();
+      if (angle < scale * c.min_rotation_step * DEG &&
+          x.tail<3>().norm() < scale * c.min_translation_step) {
+        r.converged = true;
+        break;
+      }
+      // Hard nearest-neighbour pairs can flip back and forth between two near-equal poses; a
+      // run of steps within ten times the limits is such a cycle, and as converged as it gets.
+      small_steps = angle < 10 * scale * c.min_rotation_step * DEG &&
+                            x.tail<3>().norm() < 10 * scale * c.min_translation_step
+                        ? small_steps + 1
+                        : 0;
+      if (small_steps >= 4) {
         r.converged = true;
         break;
       }

@@ -198,7 +198,8 @@ RegistrationResult registerViews(const std::vector<ViewInput>& views, const Regi
 
   // Joint rounds: every station against all the others (Gauss-Seidel). Stations that do not
   // fit after the first round leave the others' targets.
-  const int fine_first = std::min(c.candidate_levels, static_cast<int>(c.icp.voxels.size()) - 1);
+  // Placement left every station near its place: the joint rounds only need the finest level.
+  const int fine_first = static_cast<int>(c.icp.voxels.size()) - 1;
   const double t_placed = since();
   for (int round = 0; round < std::max(1, c.refinement_rounds); ++round) {
     for (std::size_t k = 0; k < stations.size(); ++k) {

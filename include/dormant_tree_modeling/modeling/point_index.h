@@ -20,6 +20,11 @@ class PointIndex {
   /// @brief Indices of the k nearest points to q (fewer when the set is smaller), nearest first.
   std::vector<int> nearest(const Eigen::Vector3d& q, int k) const;
 
+  /// @brief The nearest point to q, or -1 when the set is empty; allocation-free, for hot loops
+  /// (ICP runs it for every point in every iteration, on all threads).
+  /// @param squared_distance optional: receives its squared distance
+  int nearestOne(const Eigen::Vector3d& q, float* squared_distance = nullptr) const;
+
   /// @brief Indices of all points within radius of q.
   std::vector<int> within(const Eigen::Vector3d& q, double radius) const;
 

@@ -23,8 +23,10 @@ struct IcpConfig {
   /// ray, so such a pair only counts its offset across the target point's ray (point-to-ray).
   /// Point-to-plane on them would pull the back of the tree into the front by ~1.3 radii.
   double across_cos = -0.3;
-  double min_rotation_step = 0.005;    ///< deg: converged below both steps
-  double min_translation_step = 1e-4;  ///< m
+  /// deg and m: converged below both steps (at the finest level; coarser levels scale them
+  /// with their voxel size)
+  double min_rotation_step = 0.005;
+  double min_translation_step = 1e-4;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };

@@ -16,7 +16,7 @@ struct RegistrationConfig {
   IcpConfig icp;
   CoarseSearchConfig coarse;
   /// ICP levels (from the coarsest) run on each coarse candidate before the best is refined.
-  int candidate_levels = 2;
+  int candidate_levels = 1;
   int refinement_rounds = 3;     ///< joint rounds: every station against all the others
   std::size_t min_points = 500;  ///< fewer points (at the finest level): left out
   /// A station is kept only when this share of its points (finest level) lies on the others
