@@ -18,6 +18,7 @@ constexpr double DEG = M_PI / 180.0;
 struct Match {
   int source, target;
   double residual;  // signed point-to-plane distance, or the point-to-ray distance
+  double gap;       // how far apart the two are: 3-D, or across the ray for `across` pairs
   bool across;      // seen from opposite sides: point-to-ray
 };
 
@@ -45,6 +46,7 @@ void IcpConfig::validate() const {
   require(huber > 0, "huber must be > 0");
   require(normal_neighbors >= 5, "normal_neighbors must be >= 5");
   require(across_cos >= -1 && across_cos <= 1, "across_cos must be in [-1, 1]");
+  require(overlap_distance > 0, "overlap_distance must be > 0");
   require(min_rotation_step > 0 && min_translation_step > 0, "convergence steps must be > 0");
 }
 
@@ -91,15 +93,19 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
         const Eigen::Vector3d& vt = target.view_dirs[j];
         const bool across = !vt.isZero() && !source.view_dirs[i].isZero() &&
                             (rot * source.view_dirs[i]).dot(vt) < c.across_cos;
-        matches[i] = {i, j, across ? (d - d.dot(vt) * vt).norm() : d.dot(n), across};
+        const double ray_gap = across ? (d - d.dot(vt) * vt).norm() : 0.0;
+        matches[i] = {i, j, across ? ray_gap : d.dot(n), across ? ray_gap : d.norm(), across};
         valid[i] = 1;
       });
       std::vector<Match> used;
+      std::size_t close = 0;
       for (std::size_t i = 0; i < source.size(); ++i) {
-        if (valid[i])
+        if (valid[i]) {
           used.push_back(matches[i]);
+          close += matches[i].gap <= c.overlap_distance;
+        }
       }
-      r.overlap = static_cast<double>(used.size()) / source.size();
+      r.overlap = static_cast<double>(close) / source.size();
       if (used.size() < 10)
         throw Error(ErrorCode::EMPTY_INPUT, "ICP: the clouds do not overlap at the guess");
       const std::size_t keep =

@@ -93,7 +93,6 @@ void RegistrationConfig::validate() const {
   require(min_points >= 10, "min_points must be >= 10");
   require(min_overlap >= 0 && min_overlap <= 1, "min_overlap must be in [0, 1]");
   require(max_rmse > 0, "max_rmse must be > 0");
-  require(threads >= 0, "threads must be >= 0");
 }
 
 RegistrationResult registerViews(const std::vector<ViewInput>& views, const RegistrationConfig& c) {

@@ -22,6 +22,12 @@ RegistrationConfig loadRegistrationConfig(const std::string& path) {
                        c.icp.normal_neighbors = v.as<int>();
                      else if (key == "icp_across_cos")
                        c.icp.across_cos = v.as<double>();
+                     else if (key == "icp_overlap_distance")
+                       c.icp.overlap_distance = v.as<double>();
+                     else if (key == "icp_min_rotation_step")
+                       c.icp.min_rotation_step = v.as<double>();
+                     else if (key == "icp_min_translation_step")
+                       c.icp.min_translation_step = v.as<double>();
                      else if (key == "coarse_cell")
                        c.coarse.cell = v.as<double>();
                      else if (key == "coarse_yaw_window_deg")
@@ -50,8 +56,6 @@ RegistrationConfig loadRegistrationConfig(const std::string& path) {
                        c.max_rmse = v.as<double>();
                      else if (key == "use_hints")
                        c.use_hints = v.as<bool>();
-                     else if (key == "threads")
-                       c.threads = v.as<int>();
                      else
                        return false;
                      return true;

@@ -214,5 +214,23 @@ std::string registrationReport(const RegistrationResult& r,
   return s.str();
 }
 
+std::size_t writeRegistration(const std::string& dir, const std::vector<ViewInput>& views,
+                              const RegistrationResult& result,
+                              const std::optional<PoseErrors>& errors) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    throw Error(ErrorCode::IO_FAILURE, "cannot create " + dir + ": " + ec.message());
+  Cloud merged;
+  for (const auto& p : mergeRegistered(views, result))
+    merged.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                   static_cast<float>(p.z())));
+  io::writeCloud(dir + "/registered.pcd", merged);
+  io::writeCloud(dir + "/registered.ply", merged);
+  io::writeTextFile(dir + "/registration.json", registrationToJson(result));
+  io::writeTextFile(dir + "/registration.md", registrationReport(result, errors));
+  return merged.size();
+}
+
 }  // namespace registration
 }  // namespace dormant_tree_modeling

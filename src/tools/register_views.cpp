@@ -59,15 +59,7 @@ int main(int argc, char** argv) {
     const auto e = registration::poseErrors(result, folder.true_poses);
     if (e.views > 0)
       errors = e;
-    std::filesystem::create_directories(out);
-    Cloud merged;
-    for (const auto& p : registration::mergeRegistered(folder.views, result))
-      merged.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    io::writeCloud(out + "/registered.pcd", merged);
-    io::writeCloud(out + "/registered.ply", merged);
-    io::writeTextFile(out + "/registration.json", registration::registrationToJson(result));
-    const std::string report = registration::registrationReport(result, errors);
-    io::writeTextFile(out + "/registration.md", report);
+    const std::size_t points = registration::writeRegistration(out, folder.views, result, errors);
     int left_out = 0;
     for (const auto& v : result.views) {
       if (!v.registered) {
@@ -77,7 +69,7 @@ int main(int argc, char** argv) {
     }
     std::cout << std::fixed << std::setprecision(1) << result.views.size() - left_out << " of "
               << result.views.size() << " views registered in " << result.seconds << " s; "
-              << merged.size() << " points -> " << out << "\n";
+              << points << " points -> " << out << "\n";
     if (errors)
       std::cout << "pose error vs truth: median " << errors->median_mm << " mm / "
                 << std::setprecision(3) << errors->median_deg << " deg, max "

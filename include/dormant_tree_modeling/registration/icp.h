@@ -23,6 +23,9 @@ struct IcpConfig {
   /// ray, so such a pair only counts its offset across the target point's ray (point-to-ray).
   /// Point-to-plane on them would pull the back of the tree into the front by ~1.3 radii.
   double across_cos = -0.3;
+  /// m: a source point counts towards the overlap when a target point lies this close (across
+  /// the ray for pairs seen from opposite sides); ~2.5 sigma of the range noise.
+  double overlap_distance = 0.015;
   /// deg and m: converged below both steps (at the finest level; coarser levels scale them
   /// with their voxel size)
   double min_rotation_step = 0.005;
@@ -34,8 +37,9 @@ struct IcpConfig {
 /// @brief Result of one alignment.
 struct IcpResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  ///< source -> target
-  double rmse = 0;         ///< m, point-to-plane, over the used pairs of the last level run
-  double overlap = 0;      ///< share of source points (last level) with a target point in the limit
+  double rmse = 0;  ///< m, point-to-plane, over the used pairs of the last level run
+  double overlap =
+      0;  ///< share of source points (last level) within overlap_distance of the target
   int iterations = 0;      ///< over all levels
   bool converged = false;  ///< the last level converged before max_iterations
   /// Smallest eigenvalue of the normalised point-to-plane information (1 = every direction

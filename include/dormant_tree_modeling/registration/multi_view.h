@@ -22,10 +22,9 @@ struct RegistrationConfig {
   /// A station is kept only when this share of its points (finest level) lies on the others
   /// and the point-to-plane rmse stays below max_rmse: a view of another tree, or of nothing,
   /// does not pass.
-  double min_overlap = 0.35;
+  double min_overlap = 0.4;
   double max_rmse = 0.012;
   bool use_hints = true;  ///< false: ignore the guesses (global search from scratch)
-  int threads = 0;        ///< 0: all cores
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };

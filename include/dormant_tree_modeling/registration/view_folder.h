@@ -59,5 +59,13 @@ std::string registrationToJson(const RegistrationResult& result);
 std::string registrationReport(const RegistrationResult& result,
                                const std::optional<PoseErrors>& errors);
 
+/// @brief Write a registration to a folder: registered.pcd and registered.ply (the merged
+/// registered views), registration.json and registration.md. Creates the folder.
+/// @returns the number of points written
+/// @throws Error IO_FAILURE naming the file
+std::size_t writeRegistration(const std::string& dir, const std::vector<ViewInput>& views,
+                              const RegistrationResult& result,
+                              const std::optional<PoseErrors>& errors = std::nullopt);
+
 }  // namespace registration
 }  // namespace dormant_tree_modeling

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/String.h>
+#include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "dormant_tree_modeling/registration/multi_view.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+/// @brief ROS wrapper of the multi-view registration.
+///
+/// Collects `view_cloud`s (PointCloud2, in the platform frame as the scan assembler
+/// publishes them). A view's station is its platform position: views whose `orchard` ->
+/// platform transform (the plan's or the operator's estimate, used only as a hint) did not
+/// change belong to one station; without that transform every view is its own station.
+/// Registers on `~register` (std_srvs/Trigger), when `~expected_views` have arrived, or when
+/// the acquisition reports "finished" on `~plan_progress_topic`, on a worker thread.
+/// Publishes, latched, `~tree_cloud` (the registered views, frame `~tree_frame` = the first
+/// registered view's platform frame), `~view_poses` (geometry_msgs/PoseArray in that frame, one
+/// per input view, registered or not) and `~report` (std_msgs/String, the Markdown report), and
+/// the static tf `orchard` -> tree frame (from the first station's hint) and tree frame ->
+/// `view_<i>`. Writes registered.pcd/.ply, registration.json and registration.md to a folder
+/// per registration under `~output_dir`. `~reset` drops the views collected so far.
+/// Diagnostics: views collected, stations, the last registration's outcome.
+class RegistrationNode {
+ public:
+  /// @throws Error when the configuration cannot be loaded
+  RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~RegistrationNode();
+  RegistrationNode(const RegistrationNode&) = delete;
+  RegistrationNode& operator=(const RegistrationNode&) = delete;
+
+ private:
+  void viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
+  void progressCallback(const std_msgs::StringConstPtr& msg);
+  bool registerService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
+  /// Starts a registration of the collected views on the worker; false (and why) when busy
+  /// or when nothing was collected.
+  bool startRegistration(std::string& why);
+  void run(std::vector<registration::ViewInput> views, ros::Time stamp);
+  void publish(const std::vector<registration::ViewInput>& views,
+               const registration::RegistrationResult& result, const ros::Time& stamp);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  registration::RegistrationConfig config_;
+  std::string orchard_frame_, tree_frame_, laser_frame_, output_dir_;
+  int expected_views_ = 0;
+  double hint_timeout_ = 0.5;
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_{tf_buffer_};
+  tf2_ros::StaticTransformBroadcaster static_tf_;
+  ros::Subscriber view_sub_, progress_sub_;
+  ros::Publisher cloud_pub_, poses_pub_, report_pub_;
+  ros::ServiceServer register_srv_, reset_srv_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::Timer diagnostics_timer_;
+
+  std::mutex mutex_;
+  std::vector<registration::ViewInput> views_;
+  std::optional<Eigen::Isometry3d> last_hint_;
+  int next_station_ = 0;
+  ros::Time last_stamp_;
+  bool busy_ = false;
+  std::string last_outcome_ = "no registration yet";
+  bool last_ok_ = true;
+  std::thread worker_;
+};
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,295 @@
+#include "dormant_tree_modeling/ros/registration_node.h"
+
+#include <geometry_msgs/PoseArray.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/registration/view_folder.h"
+#include "dormant_tree_modeling/ros/conversions.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+namespace {
+
+registration::RegistrationConfig loadConfig(ros::NodeHandle& pnh) {
+  const std::string file = pnh.param<std::string>("config_file", "");
+  if (file.empty()) {
+    ROS_WARN(
+        "~config_file not set: using the built-in defaults (config/registration.yaml holds "
+        "them too)");
+    return registration::RegistrationConfig{};
+  }
+  return registration::loadRegistrationConfig(file);
+}
+
+std::string defaultOutputDir() {
+  if (const char* ros_home = std::getenv("ROS_HOME"))
+    return std::string(ros_home) + "/registration";
+  if (const char* home = std::getenv("HOME"))
+    return std::string(home) + "/.ros/registration";
+  return "registration";
+}
+
+// The same platform position: the hint moved by less than a millimetre and a hundredth of a
+// degree (a static transform republished, not a platform move).
+bool samePlace(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  const Eigen::Isometry3d d = a.inverse() * b;
+  return d.translation().norm() < 1e-3 && Eigen::AngleAxisd(d.linear()).angle() < 1.75e-4;
+}
+
+}  // namespace
+
+RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+    : config_(loadConfig(pnh)) {
+  orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
+  tree_frame_ = pnh.param<std::string>("tree_frame", "tree");
+  laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
+  output_dir_ = pnh.param<std::string>("output_dir", defaultOutputDir());
+  expected_views_ = pnh.param<int>("expected_views", 0);
+  hint_timeout_ = pnh.param<double>("hint_timeout", 0.5);
+  if (expected_views_ < 0)
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "~expected_views must be >= 0 (0: no automatic "
+                "registration by count)");
+  if (hint_timeout_ < 0)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~hint_timeout must be >= 0 s");
+  if (tree_frame_.empty() || orchard_frame_.empty() || tree_frame_ == orchard_frame_)
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "~tree_frame and ~orchard_frame must be two different, non-empty frame names");
+
+  cloud_pub_ = pnh.advertise<sensor_msgs::PointCloud2>("tree_cloud", 1, true);
+  poses_pub_ = pnh.advertise<geometry_msgs::PoseArray>("view_poses", 1, true);
+  report_pub_ = pnh.advertise<std_msgs::String>("report", 1, true);
+  view_sub_ = nh.subscribe("view_cloud", 50, &RegistrationNode::viewCallback, this);
+  const std::string progress = pnh.param<std::string>("plan_progress_topic", "");
+  if (!progress.empty())
+    progress_sub_ = nh.subscribe(progress, 10, &RegistrationNode::progressCallback, this);
+  register_srv_ = pnh.advertiseService("register", &RegistrationNode::registerService, this);
+  reset_srv_ = pnh.advertiseService("reset", &RegistrationNode::resetService, this);
+
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("registration", this, &RegistrationNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  ROS_INFO("registration: collecting views on %s; registers on ~register%s%s",
+           view_sub_.getTopic().c_str(),
+           expected_views_ > 0 ? (" or after " + std::to_string(expected_views_) + " views").c_str()
+                               : "",
+           progress.empty() ? "" : (" or when " + progress + " reports finished").c_str());
+}
+
+RegistrationNode::~RegistrationNode() {
+  if (worker_.joinable())
+    worker_.join();
+}
+
+void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  registration::ViewInput v;
+  std::size_t dropped = 0;
+  try {
+    const CloudPtr cloud = fromMsg(*msg, &dropped);
+    v.points.reserve(cloud->size());
+    for (const auto& p : *cloud)
+      v.points.emplace_back(p.x, p.y, p.z);
+  } catch (const Error& e) {
+    ROS_ERROR("registration: view (stamp %.3f) not used: %s", msg->header.stamp.toSec(), e.what());
+    return;
+  }
+  // The laser's place in the view's frame (for the side a surface was seen from), and the
+  // platform's hinted place in the orchard.
+  v.sensor = Eigen::Vector3d::Zero();  // the frame's origin: close enough to tell the side
+  if (tf_buffer_._frameExists(laser_frame_)) {
+    try {
+      v.sensor = tf2::transformToEigen(tf_buffer_.lookupTransform(msg->header.frame_id,
+                                                                  laser_frame_, msg->header.stamp,
+                                                                  ros::Duration(hint_timeout_)))
+                     .translation();
+    } catch (const tf2::TransformException&) {
+    }
+  }
+  std::optional<Eigen::Isometry3d> hint;
+  try {
+    hint = tf2::transformToEigen(tf_buffer_.lookupTransform(
+        orchard_frame_, msg->header.frame_id, msg->header.stamp, ros::Duration(hint_timeout_)));
+  } catch (const tf2::TransformException&) {
+  }
+  bool start = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!hint || !last_hint_ || !samePlace(*hint, *last_hint_) || views_.empty())
+      ++next_station_;
+    last_hint_ = hint;
+    v.station = next_station_;
+    v.station_hint = hint;
+    v.name = "view_" + std::to_string(views_.size());
+    views_.push_back(std::move(v));
+    last_stamp_ = msg->header.stamp;
+    ROS_INFO("registration: %s (%zu points%s), station %d%s", views_.back().name.c_str(),
+             views_.back().points.size(),
+             dropped ? (", " + std::to_string(dropped) + " non-finite dropped").c_str() : "",
+             views_.back().station, hint ? "" : " (no platform hint)");
+    start = expected_views_ > 0 && static_cast<int>(views_.size()) >= expected_views_;
+  }
+  if (start) {
+    std::string why;
+    if (!startRegistration(why))
+      ROS_WARN("registration: %s", why.c_str());
+  }
+}
+
+void RegistrationNode::progressCallback(const std_msgs::StringConstPtr& msg) {
+  if (msg->data.rfind("finished", 0) != 0)
+    return;
+  std::string why;
+  if (!startRegistration(why))
+    ROS_WARN("registration: the plan finished, but %s", why.c_str());
+}
+
+bool RegistrationNode::registerService(std_srvs::Trigger::Request&,
+                                       std_srvs::Trigger::Response& res) {
+  std::string why;
+  res.success = startRegistration(why);
+  res.message = why;
+  return true;
+}
+
+bool RegistrationNode::resetService(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  res.message = "dropped " + std::to_string(views_.size()) + " views";
+  views_.clear();
+  last_hint_.reset();
+  res.success = true;
+  return true;
+}
+
+bool RegistrationNode::startRegistration(std::string& why) {
+  std::vector<registration::ViewInput> views;
+  ros::Time stamp;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (busy_) {
+      why = "a registration is already running";
+      return false;
+    }
+    if (views_.empty()) {
+      why = "no views collected yet on " + view_sub_.getTopic();
+      return false;
+    }
+    // The views go to the worker; new ones start the next tree.
+    views.swap(views_);
+    last_hint_.reset();
+    stamp = last_stamp_;
+    busy_ = true;
+  }
+  if (worker_.joinable())
+    worker_.join();
+  why = "registering " + std::to_string(views.size()) + " views";
+  worker_ = std::thread(&RegistrationNode::run, this, std::move(views), stamp);
+  return true;
+}
+
+void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time stamp) {
+  std::string outcome;
+  bool ok = false;
+  try {
+    const registration::RegistrationResult result = registration::registerViews(views, config_);
+    int registered = 0;
+    for (const auto& v : result.views) {
+      registered += v.registered;
+      if (!v.registered)
+        ROS_WARN("registration: %s left out: %s", v.name.c_str(), v.reason.c_str());
+    }
+    publish(views, result, stamp);
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(1) << registered << " of " << views.size()
+      << " views registered in " << result.seconds << " s";
+    try {
+      std::ostringstream dir;
+      dir << output_dir_ << "/" << std::fixed << std::setprecision(0) << stamp.toSec();
+      const std::size_t points = registration::writeRegistration(dir.str(), views, result);
+      s << "; " << points << " points written to " << dir.str();
+    } catch (const Error& e) {
+      s << "; NOT written: " << e.what();
+      ROS_ERROR("registration: %s", e.what());
+    }
+    outcome = s.str();
+    ok = registered == static_cast<int>(views.size());
+    ROS_INFO("registration: %s", outcome.c_str());
+  } catch (const std::exception& e) {
+    outcome = std::string("failed: ") + e.what();
+    ROS_ERROR("registration: %s", outcome.c_str());
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  last_outcome_ = outcome;
+  last_ok_ = ok;
+  busy_ = false;
+}
+
+void RegistrationNode::publish(const std::vector<registration::ViewInput>& views,
+                               const registration::RegistrationResult& result,
+                               const ros::Time& stamp) {
+  Cloud merged;
+  for (const auto& p : registration::mergeRegistered(views, result))
+    merged.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                   static_cast<float>(p.z())));
+  geometry_msgs::PoseArray poses;
+  poses.header.frame_id = tree_frame_;
+  poses.header.stamp = stamp;
+  std::vector<geometry_msgs::TransformStamped> tfs;
+  // The tree frame is the first registered view's platform frame; its hint places it in the
+  // orchard (identity without one, so rviz can still show it).
+  Eigen::Isometry3d tree_in_orchard = Eigen::Isometry3d::Identity();
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (result.views[i].registered && views[i].station_hint) {
+      tree_in_orchard = *views[i].station_hint * result.views[i].pose.inverse();
+      break;
+    }
+  }
+  geometry_msgs::TransformStamped root = tf2::eigenToTransform(tree_in_orchard);
+  root.header.frame_id = orchard_frame_;
+  root.header.stamp = stamp;
+  root.child_frame_id = tree_frame_;
+  tfs.push_back(root);
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    poses.poses.push_back(tf2::toMsg(result.views[i].pose));
+    if (!result.views[i].registered)
+      continue;
+    geometry_msgs::TransformStamped t = tf2::eigenToTransform(result.views[i].pose);
+    t.header.frame_id = tree_frame_;
+    t.header.stamp = stamp;
+    t.child_frame_id = views[i].name;
+    tfs.push_back(t);
+  }
+  static_tf_.sendTransform(tfs);
+  poses_pub_.publish(poses);
+  std_msgs::String report;
+  report.data = registration::registrationReport(result, std::nullopt);
+  report_pub_.publish(report);
+  cloud_pub_.publish(toMsg(merged, tree_frame_, stamp));
+}
+
+void RegistrationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(mutex_);
+  status.add("views collected", views_.size());
+  status.add("stations collected",
+             views_.empty() ? 0 : views_.back().station - views_.front().station + 1);
+  status.add("last registration", last_outcome_);
+  if (busy_)
+    status.summary(DiagnosticStatus::OK, "registering");
+  else if (!last_ok_)
+    status.summary(DiagnosticStatus::WARN, "last registration: " + last_outcome_);
+  else
+    status.summary(DiagnosticStatus::OK,
+                   std::to_string(views_.size()) + " views collected; " + last_outcome_);
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling
