@@ -8,7 +8,6 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/registration/icp.h>
-#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -23,17 +22,12 @@
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
+#include "peak_rss.h"
 
 using namespace dormant_tree_modeling;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double peakMiB() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_maxrss) / 1024.0;
-}
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const registration::Points& pts,
                                           const Eigen::Isometry3d& t, double voxel) {
@@ -141,7 +135,7 @@ int main(int argc, char** argv) {
         simulation::writeDataset(o, dir);
       const auto folder = registration::readViewFolder(dir);
       const auto result = registration::registerViews(folder.views, {});
-      const double mem = peakMiB();
+      const double mem = bench::peakRssMiB();
       const auto e = registration::poseErrors(result, folder.true_poses);
       int registered = 0;
       for (const auto& v : result.views)

@@ -11,33 +11,15 @@
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/io/pose_json.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
 
 namespace {
-
-std::optional<Eigen::Isometry3d> poseFrom(const nlohmann::json& v, const char* key) {
-  if (!v.contains(key))
-    return std::nullopt;
-  const auto& p = v.at(key);
-  const auto t = p.at("translation").get<std::vector<double>>();
-  const auto q = p.at("rotation_xyzw").get<std::vector<double>>();
-  if (t.size() != 3 || q.size() != 4)
-    throw Error(ErrorCode::PARSE_ERROR, std::string(key) + " needs 3 + 4 numbers");
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-  pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
-  return pose;
-}
-
-nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.linear());
-  const Eigen::Vector3d t = pose.translation();
-  return {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
-}
 
 // The ground's height in a view without a guess: the lowest 2 cm level holding 5 % of the
 // points, or none.
@@ -58,13 +40,6 @@ std::optional<double> lowestDenseLevel(const Points& pts) {
   return std::nullopt;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty())
-    return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& options) {
@@ -79,8 +54,8 @@ ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& optio
       ViewInput in;
       in.name = v.at("name").get<std::string>();
       in.station = v.value("platform_index", v.value("index", 0));
-      const auto truth = poseFrom(v, "true_pose");
-      const auto guess = poseFrom(v, "guess_pose");
+      const auto truth = io::poseFromJson(v, "true_pose");
+      const auto guess = io::poseFromJson(v, "guess_pose");
       f.true_poses.push_back(truth);
       f.guess_poses.push_back(guess);
       if (guess) {
@@ -163,7 +138,7 @@ std::string registrationToJson(const RegistrationResult& r) {
     views.push_back({{"name", v.name},
                      {"station", v.station},
                      {"registered", v.registered},
-                     {"pose", poseJson(v.pose)},
+                     {"pose", io::poseToJson(v.pose)},
                      {"rmse_m", v.rmse},
                      {"overlap", v.overlap},
                      {"confidence", v.confidence},
@@ -214,22 +189,24 @@ std::string registrationReport(const RegistrationResult& r,
   return s.str();
 }
 
-std::size_t writeRegistration(const std::string& dir, const std::vector<ViewInput>& views,
-                              const RegistrationResult& result,
-                              const std::optional<PoseErrors>& errors) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec)
-    throw Error(ErrorCode::IO_FAILURE, "cannot create " + dir + ": " + ec.message());
+Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationResult& result) {
   Cloud merged;
   for (const auto& p : mergeRegistered(views, result))
     merged.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                    static_cast<float>(p.z())));
-  io::writeCloud(dir + "/registered.pcd", merged);
-  io::writeCloud(dir + "/registered.ply", merged);
+  return merged;
+}
+
+void writeRegistration(const std::string& dir, const Cloud& registered,
+                       const RegistrationResult& result, const std::optional<PoseErrors>& errors) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    throw Error(ErrorCode::IO_FAILURE, "cannot create " + dir + ": " + ec.message());
+  io::writeCloud(dir + "/registered.pcd", registered);
+  io::writeCloud(dir + "/registered.ply", registered);
   io::writeTextFile(dir + "/registration.json", registrationToJson(result));
   io::writeTextFile(dir + "/registration.md", registrationReport(result, errors));
-  return merged.size();
 }
 
 }  // namespace registration

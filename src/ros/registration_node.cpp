@@ -200,27 +200,28 @@ void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time
   bool ok = false;
   try {
     const registration::RegistrationResult result = registration::registerViews(views, config_);
-    int registered = 0;
+    int registered_views = 0;
     for (const auto& v : result.views) {
-      registered += v.registered;
+      registered_views += v.registered;
       if (!v.registered)
         ROS_WARN("registration: %s left out: %s", v.name.c_str(), v.reason.c_str());
     }
-    publish(views, result, stamp);
+    const Cloud registered = registration::registeredCloud(views, result);
+    publish(registered, views, result, stamp);
     std::ostringstream s;
-    s << std::fixed << std::setprecision(1) << registered << " of " << views.size()
+    s << std::fixed << std::setprecision(1) << registered_views << " of " << views.size()
       << " views registered in " << result.seconds << " s";
     try {
       std::ostringstream dir;
       dir << output_dir_ << "/" << std::fixed << std::setprecision(0) << stamp.toSec();
-      const std::size_t points = registration::writeRegistration(dir.str(), views, result);
-      s << "; " << points << " points written to " << dir.str();
+      registration::writeRegistration(dir.str(), registered, result);
+      s << "; " << registered.size() << " points written to " << dir.str();
     } catch (const Error& e) {
       s << "; NOT written: " << e.what();
       ROS_ERROR("registration: %s", e.what());
     }
     outcome = s.str();
-    ok = registered == static_cast<int>(views.size());
+    ok = registered_views == static_cast<int>(views.size());
     ROS_INFO("registration: %s", outcome.c_str());
   } catch (const std::exception& e) {
     outcome = std::string("failed: ") + e.what();
@@ -232,13 +233,10 @@ void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time
   busy_ = false;
 }
 
-void RegistrationNode::publish(const std::vector<registration::ViewInput>& views,
+void RegistrationNode::publish(const Cloud& registered,
+                               const std::vector<registration::ViewInput>& views,
                                const registration::RegistrationResult& result,
                                const ros::Time& stamp) {
-  Cloud merged;
-  for (const auto& p : registration::mergeRegistered(views, result))
-    merged.push_back(pcl::PointXYZ(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                                   static_cast<float>(p.z())));
   geometry_msgs::PoseArray poses;
   poses.header.frame_id = tree_frame_;
   poses.header.stamp = stamp;
@@ -272,7 +270,7 @@ void RegistrationNode::publish(const std::vector<registration::ViewInput>& views
   std_msgs::String report;
   report.data = registration::registrationReport(result, std::nullopt);
   report_pub_.publish(report);
-  cloud_pub_.publish(toMsg(merged, tree_frame_, stamp));
+  cloud_pub_.publish(toMsg(registered, tree_frame_, stamp));
 }
 
 void RegistrationNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

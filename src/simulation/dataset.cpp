@@ -10,6 +10,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/io/pose_json.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/simulation/preview.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
@@ -19,12 +20,6 @@ namespace dormant_tree_modeling {
 namespace simulation {
 
 namespace {
-
-nlohmann::json poseJson(const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.linear());
-  const Eigen::Vector3d t = pose.translation();
-  return {{"translation", {t.x(), t.y(), t.z()}}, {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
-}
 
 /// Axis-aligned box of the true tree (trunk and primaries) grown by a margin.
 void truthBox(const evaluation::GroundTruth& truth, double margin, Eigen::Vector3d& lo,
@@ -111,8 +106,8 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
                          {"platform_index", v.platform_index},
                          {"slide", v.slide},
                          {"points", local->size()},
-                         {"true_pose", poseJson(stage)},
-                         {"guess_pose", poseJson(guess_stage)}});
+                         {"true_pose", io::poseToJson(stage)},
+                         {"guess_pose", io::poseToJson(guess_stage)}});
   }
   summary.views = static_cast<int>(plan.size());
   const nlohmann::json views_file{

@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
     const auto e = registration::poseErrors(result, folder.true_poses);
     if (e.views > 0)
       errors = e;
-    const std::size_t points = registration::writeRegistration(out, folder.views, result, errors);
+    const Cloud registered = registration::registeredCloud(folder.views, result);
+    registration::writeRegistration(out, registered, result, errors);
+    const std::size_t points = registered.size();
     int left_out = 0;
     for (const auto& v : result.views) {
       if (!v.registered) {

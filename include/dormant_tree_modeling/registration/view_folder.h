@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
@@ -59,13 +60,16 @@ std::string registrationToJson(const RegistrationResult& result);
 std::string registrationReport(const RegistrationResult& result,
                                const std::optional<PoseErrors>& errors);
 
+/// @brief The registered views merged into one cloud (mergeRegistered as a PCL cloud).
+Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationResult& result);
+
 /// @brief Write a registration to a folder: registered.pcd and registered.ply (the merged
-/// registered views), registration.json and registration.md. Creates the folder.
-/// @returns the number of points written
+/// registered views, from registeredCloud), registration.json and registration.md. Creates
+/// the folder.
 /// @throws Error IO_FAILURE naming the file
-std::size_t writeRegistration(const std::string& dir, const std::vector<ViewInput>& views,
-                              const RegistrationResult& result,
-                              const std::optional<PoseErrors>& errors = std::nullopt);
+void writeRegistration(const std::string& dir, const Cloud& registered,
+                       const RegistrationResult& result,
+                       const std::optional<PoseErrors>& errors = std::nullopt);
 
 }  // namespace registration
 }  // namespace dormant_tree_modeling

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
@@ -52,7 +53,7 @@ class RegistrationNode {
   /// or when nothing was collected.
   bool startRegistration(std::string& why);
   void run(std::vector<registration::ViewInput> views, ros::Time stamp);
-  void publish(const std::vector<registration::ViewInput>& views,
+  void publish(const Cloud& registered, const std::vector<registration::ViewInput>& views,
                const registration::RegistrationResult& result, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
