@@ -1,9 +1,11 @@
 #include "dormant_tree_modeling/ros/acquisition_node.h"
 
 #include <dormant_tree_modeling/MoveAxis.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <std_msgs/String.h>
 
+#include <algorithm>
 #include <boost/bind/bind.hpp>
 #include <cmath>
 #include <filesystem>
@@ -32,8 +34,8 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   max_retries_ = pnh.param("max_retries", 2);
   drain_s_ = pnh.param("drain_seconds", 1.0);
   topics_ = pnh.param<std::vector<std::string>>(
-      "record_topics",
-      {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static", "/assembler/view_cloud"});
+      "record_topics", {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static",
+                        "/assembler/view_cloud", "/acquisition/progress"});
   if (tree_name_.empty() || tree_name_.find('/') != std::string::npos)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~tree_name must be a plain file name");
   if (max_retries_ < 0 || max_retries_ > 10)
@@ -42,6 +44,7 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
     throw Error(ErrorCode::INVALID_ARGUMENT, "~drain_seconds must be in 0..60");
   prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
   progress_pub_ = pnh.advertise<std_msgs::String>("progress", 1, true);
+  goal_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_goal", 1, true);
   start_srv_ = pnh.advertiseService("start", &AcquisitionNode::start, this);
   cancel_srv_ = pnh.advertiseService("cancel", &AcquisitionNode::cancel, this);
   in_place_srv_ =
@@ -50,8 +53,12 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
     recorders_.push_back(nh.subscribe<topic_tools::ShapeShifter>(
         topic, 1000, boost::bind(&AcquisitionNode::record, this, topic, boost::placeholders::_1)));
   }
-  publish(progress_pub_, "idle: " + std::to_string(acquisition::makeViewPlan(plan_).size()) +
-                             " views planned; call ~start");
+  total_ = static_cast<int>(acquisition::makeViewPlan(plan_).size());
+  publish(progress_pub_, "idle: " + std::to_string(total_) + " views planned; call ~start");
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("acquisition", this, &AcquisitionNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
   if (pnh.param("autostart", false)) {
     running_ = true;
     worker_ = std::thread([this] { run(); });
@@ -127,7 +134,20 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     in_place_ = false;
+    state_ = "waiting for the platform at position " + std::to_string(view.platform_index + 1);
   }
+  geometry_msgs::PoseStamped goal;
+  goal.header.stamp = ros::Time::now();
+  goal.header.frame_id = orchard_frame_;
+  goal.pose.position.x = t.x();
+  goal.pose.position.y = t.y();
+  goal.pose.position.z = t.z();
+  const Eigen::Quaterniond q(view.platform.linear());
+  goal.pose.orientation.x = q.x();
+  goal.pose.orientation.y = q.y();
+  goal.pose.orientation.z = q.z();
+  goal.pose.orientation.w = q.w();
+  goal_pub_.publish(goal);
   publish(prompt_pub_, m.str());
   ROS_INFO("%s", m.str().c_str());
   std::unique_lock<std::mutex> lock(mutex_);
@@ -142,13 +162,16 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   tf.transform.translation.x = t.x();
   tf.transform.translation.y = t.y();
   tf.transform.translation.z = t.z();
-  const Eigen::Quaterniond q(view.platform.linear());
   tf.transform.rotation.x = q.x();
   tf.transform.rotation.y = q.y();
   tf.transform.rotation.z = q.z();
   tf.transform.rotation.w = q.w();
   static_tf_.sendTransform(tf);
   publish(prompt_pub_, "platform at position " + std::to_string(view.platform_index + 1));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = "scanning";
+  }
   return true;
 }
 
@@ -163,8 +186,18 @@ void AcquisitionNode::run() {
   } catch (const rosbag::BagException& e) {
     publish(progress_pub_, std::string("cannot record to ") + bag_path + ": " + e.what());
     ROS_ERROR("cannot record to %s: %s", bag_path.c_str(), e.what());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = std::string("cannot record to ") + bag_path + ": " + e.what();
+    state_ = "idle";
     running_ = false;
     return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = "running";
+    done_ = failed_ = 0;
+    total_ = static_cast<int>(plan.size());
+    last_problem_.clear();
   }
   acquisition::SequencerActions a;
   a.move_platform = [this](const acquisition::PlannedView& v) { return askForPlatform(v); };
@@ -196,6 +229,9 @@ void AcquisitionNode::run() {
       << " min left: " << p.message;
     publish(progress_pub_, m.str());
     ROS_INFO("%s", m.str().c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = p.done;
+    failed_ = p.failed;
   };
   a.cancelled = [this] { return cancel_.load() || !ros::ok(); };
   std::vector<acquisition::ViewOutcome> outcomes;
@@ -203,22 +239,47 @@ void AcquisitionNode::run() {
     outcomes = acquisition::runPlan(plan, a, max_retries_);
   } catch (const Error& e) {
     ROS_ERROR("acquisition stopped: %s", e.what());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = std::string("stopped: ") + e.what();
   }
   // Messages of the last view may still be in transit (the view cloud is published just
-  // before acquire_view returns): let them arrive before the bag closes.
+  // before acquire_view returns): let them arrive before the bag closes, and the final
+  // progress with them, so a replay of the bag sees the plan end after its last view.
   ros::WallDuration(drain_s_).sleep();
+  const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
+  const std::string summary = report.substr(0, report.find('\n'));
+  publish(progress_pub_, "finished: " + summary);
+  ros::WallDuration(std::min(drain_s_, 0.2)).sleep();
   {
     std::lock_guard<std::mutex> lock(bag_mutex_);
     recording_ = false;
     bag_.close();
   }
-  const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
   std::ofstream(output_dir_ + "/" + tree_name_ + "_report.md")
       << "# Acquisition of " << tree_name_ << "\n\nBag: " << bag_path << "\n\n"
       << report;
-  publish(progress_pub_, "finished: " + report.substr(0, report.find('\n')));
-  ROS_INFO("acquisition finished: %s", report.substr(0, report.find('\n')).c_str());
+  ROS_INFO("acquisition finished: %s", summary.c_str());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_ = "finished: " + summary;
+  }
   running_ = false;
+}
+
+void AcquisitionNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(mutex_);
+  status.add("state", state_);
+  status.add("views done", done_);
+  status.add("views failed", failed_);
+  status.add("views planned", total_);
+  status.add("bag", output_dir_ + "/" + tree_name_ + ".bag");
+  if (!last_problem_.empty())
+    status.summary(DiagnosticStatus::ERROR, last_problem_);
+  else if (failed_ > 0)
+    status.summary(DiagnosticStatus::WARN, std::to_string(failed_) + " views failed");
+  else
+    status.summary(DiagnosticStatus::OK, state_);
 }
 
 }  // namespace ros_layer

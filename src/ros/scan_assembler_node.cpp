@@ -55,12 +55,36 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   p.isolation.max_height = pnh.param("max_height", p.isolation.max_height);
   p.validate();
   recorder_ = std::make_unique<acquisition::SweepRecorder>(buffer_s);
+  passive_ = pnh.param("passive", false);
+  if (passive_) {
+    watcher_ =
+        std::make_unique<acquisition::SweepWatcher>(sweep_.theta_min * DEG, sweep_.theta_max * DEG);
+    worker_ = std::thread([this] { passiveLoop(); });
+  }
 
   scan_sub_ = nh.subscribe("scan", 200, &ScanAssemblerNode::scanCallback, this);
   joint_sub_ = nh.subscribe("joint_states", 500, &ScanAssemblerNode::jointCallback, this);
   cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 2, true);
   image_pub_ = nh.advertise<sensor_msgs::Image>("range_image", 2, true);
-  acquire_srv_ = pnh.advertiseService("acquire_view", &ScanAssemblerNode::acquireView, this);
+  if (!passive_)
+    acquire_srv_ = pnh.advertiseService("acquire_view", &ScanAssemblerNode::acquireView, this);
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("scan assembler", this, &ScanAssemblerNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  if (passive_)
+    ROS_INFO("scan_assembler: passive, assembling the sweeps seen on %s",
+             joint_sub_.getTopic().c_str());
+}
+
+ScanAssemblerNode::~ScanAssemblerNode() {
+  {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable())
+    worker_.join();
 }
 
 void ScanAssemblerNode::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) {
@@ -72,13 +96,82 @@ void ScanAssemblerNode::scanCallback(const sensor_msgs::LaserScanConstPtr& msg) 
   l.ranges = msg->ranges;
   l.intensities = msg->intensities;
   recorder_->addLine(std::move(l), msg->scan_time);
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  ++scans_;
+  last_scan_wall_ = ros::WallTime::now().toSec();
 }
 
 void ScanAssemblerNode::jointCallback(const sensor_msgs::JointStateConstPtr& msg) {
   for (std::size_t i = 0; i < msg->name.size() && i < msg->position.size(); ++i) {
-    if (msg->name[i] == rotary_joint_)
-      recorder_->addPosition(msg->header.stamp.toSec(), msg->position[i]);
+    if (msg->name[i] != rotary_joint_)
+      continue;
+    recorder_->addPosition(msg->header.stamp.toSec(), msg->position[i]);
+    if (!watcher_)
+      continue;
+    if (const auto sweep = watcher_->add(msg->header.stamp.toSec(), msg->position[i])) {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      sweeps_.push_back(*sweep);
+      wake_.notify_all();
+    }
   }
+}
+
+void ScanAssemblerNode::passiveLoop() {
+  while (true) {
+    acquisition::WatchedSweep sweep;
+    {
+      std::unique_lock<std::mutex> lock(state_mutex_);
+      wake_.wait(lock, [this] { return stop_ || !sweeps_.empty(); });
+      if (stop_)
+        return;
+      sweep = sweeps_.front();
+      sweeps_.pop_front();
+    }
+    const ros::WallTime started = ros::WallTime::now();
+    try {
+      // A line stamped after the sweep's end shows that all of its lines have arrived.
+      recorder_->firstLineAfter(sweep.end, 3.0);
+      std::size_t dropped = 0, missing = 0;
+      const acquisition::RangeImage image = acquisition::assembleRangeImage(
+          recorder_->linesBetween(sweep.begin, sweep.end), recorder_->history(),
+          sweep_.theta_min * DEG, sweep_.theta_max * DEG, &dropped, sweep_.theta_step * DEG,
+          &missing);
+      if (image.rows == 0)
+        throw Error(ErrorCode::EMPTY_INPUT, "no scan line of the sweep had stage positions");
+      const std::string summary = publishView(image, dropped, missing, started);
+      ROS_INFO("view assembled from a %s sweep: %s", sweep.upwards ? "rising" : "falling",
+               summary.c_str());
+      noteOutcome(true, summary);
+    } catch (const Error& e) {
+      ROS_ERROR("a sweep seen on %s gave no view: %s", joint_sub_.getTopic().c_str(), e.what());
+      noteOutcome(false, e.what());
+    }
+  }
+}
+
+void ScanAssemblerNode::noteOutcome(bool ok, const std::string& message) {
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  (ok ? views_ : failures_) += 1;
+  last_ok_ = ok;
+  last_outcome_ = message;
+}
+
+void ScanAssemblerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(state_mutex_);
+  status.add("mode", passive_ ? "passive (sweeps seen in joint_states)"
+                              : (sweep_.continuous ? "continuous" : "step-and-scan"));
+  status.add("scans received", scans_);
+  status.add("views published", views_);
+  status.add("views failed", failures_);
+  status.add("last view", last_outcome_);
+  const double age = ros::WallTime::now().toSec() - last_scan_wall_;
+  if (!last_ok_)
+    status.summary(DiagnosticStatus::ERROR, "last view failed: " + last_outcome_);
+  else if (scans_ == 0 || age > 2.0)
+    status.summary(DiagnosticStatus::WARN, "no scans from the laser on " + scan_sub_.getTopic());
+  else
+    status.summary(DiagnosticStatus::OK, std::to_string(views_) + " views");
 }
 
 double ScanAssemblerNode::lastScanPeriod() {
@@ -116,6 +209,11 @@ std::string ScanAssemblerNode::acquire() {
   recorder_->bind(io);
   std::size_t dropped = 0, missing = 0;
   acquisition::RangeImage image = acquisition::runSweep(io, sweep_, &dropped, &missing);
+  return publishView(std::move(image), dropped, missing, started);
+}
+
+std::string ScanAssemblerNode::publishView(acquisition::RangeImage image, std::size_t dropped,
+                                           std::size_t missing, const ros::WallTime& started) {
   // A laser that dropped out mid-sweep leaves empty rows: fail the view so it is retried.
   if (missing > max_missing_rows_ * image.rows) {
     throw Error(ErrorCode::IO_FAILURE, std::to_string(missing) + " of " +
@@ -165,6 +263,7 @@ bool ScanAssemblerNode::acquireView(std_srvs::Trigger::Request&, std_srvs::Trigg
     res.message = e.what();
     ROS_ERROR("acquire_view failed: %s", e.what());
   }
+  noteOutcome(res.success, res.message);
   return true;
 }
 

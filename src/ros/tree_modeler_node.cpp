@@ -2,11 +2,15 @@
 
 #include <dormant_tree_modeling/TreeModel.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <filesystem>
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/cylinder_csv.h"
+#include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/ros/model_messages.h"
 
@@ -51,6 +55,14 @@ sensor_msgs::PointCloud2 segmentsMsg(const modeling::ModelResult& result,
 
 TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     : modeler_(loadConfig(pnh)) {
+  output_dir_ = pnh.param<std::string>("output_dir", "");
+  output_frame_ = pnh.param<std::string>("output_frame", "");
+  if (!output_dir_.empty())
+    std::filesystem::create_directories(output_dir_);
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("tree modeler", this, &TreeModelerNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
   model_pub_ = nh.advertise<dormant_tree_modeling::TreeModel>("tree_model", 1, true);
   marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
   segments_pub_ = nh.advertise<sensor_msgs::PointCloud2>("segments", 1, true);
@@ -122,7 +134,8 @@ void TreeModelerNode::workerLoop() {
       pending_.reset();
     }
     try {
-      ROS_INFO("tree_modeler: %s", process(*cloud).c_str());
+      const std::string summary = process(*cloud);
+      ROS_INFO("tree_modeler: %s", summary.c_str());
     } catch (const Error& e) {
       ROS_ERROR("tree_modeler: %s: %s", errorCodeName(e.code()), e.what());
     } catch (const std::exception& e) {
@@ -132,14 +145,33 @@ void TreeModelerNode::workerLoop() {
 }
 
 std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
-  std::size_t dropped = 0;
-  const CloudPtr cloud = fromMsg(msg, &dropped);
-  if (dropped > 0)
-    ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
-  const modeling::ModelResult result = modeler_.model(*cloud);
-  model_pub_.publish(toMsg(result.model, msg.header));
-  marker_pub_.publish(toMarkers(result.model, msg.header));
-  segments_pub_.publish(segmentsMsg(result, msg.header));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    busy_ = true;
+  }
+  try {
+    std::size_t dropped = 0;
+    const CloudPtr cloud = fromMsg(msg, &dropped);
+    if (dropped > 0)
+      ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
+    const modeling::ModelResult result = modeler_.model(*cloud);
+    const std::string summary = publish(result, msg.header);
+    noteOutcome(true, summary);
+    return summary;
+  } catch (const Error& e) {
+    noteOutcome(false, std::string(errorCodeName(e.code())) + ": " + e.what());
+    throw;
+  } catch (const std::exception& e) {
+    noteOutcome(false, e.what());
+    throw;
+  }
+}
+
+std::string TreeModelerNode::publish(const modeling::ModelResult& result,
+                                     const std_msgs::Header& header) {
+  model_pub_.publish(toMsg(result.model, header));
+  marker_pub_.publish(toMarkers(result.model, header));
+  segments_pub_.publish(segmentsMsg(result, header));
   std::size_t prune = 0;
   for (const auto& b : result.model.primary_branches)
     prune += b.measurement.prune;
@@ -147,7 +179,50 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
   s << result.model.trunk.size() << " trunk cylinders, " << result.model.primary_branches.size()
     << " primary branches (" << prune << " to prune) from " << result.model.input_points
     << " points in " << result.model.runtime_s << " s";
+  if (!output_dir_.empty())
+    writeFiles(result.model, header);
   return s.str();
+}
+
+void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const std_msgs::Header& header) {
+  modeling::TreeModel out = model;
+  if (!output_frame_.empty() && output_frame_ != header.frame_id) {
+    try {
+      out = modeling::transformModel(
+          model, tf2::transformToEigen(tf_buffer_.lookupTransform(
+                     output_frame_, header.frame_id, header.stamp, ros::Duration(2.0))));
+    } catch (const tf2::TransformException& e) {
+      throw Error(ErrorCode::IO_FAILURE, "the model was published but not written: no transform " +
+                                             output_frame_ + " <- " + header.frame_id + ": " +
+                                             e.what());
+    }
+  }
+  io::writeTextFile(output_dir_ + "/model.json", io::modelToJson(out));
+  io::writeTextFile(output_dir_ + "/cylinders.csv", io::cylindersToCsv(out));
+}
+
+void TreeModelerNode::noteOutcome(bool ok, const std::string& message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  busy_ = false;
+  (ok ? models_ : failures_) += 1;
+  last_ok_ = ok;
+  last_outcome_ = message;
+}
+
+void TreeModelerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(mutex_);
+  status.add("models", models_);
+  status.add("failures", failures_);
+  status.add("modeling now", busy_);
+  status.add("cloud waiting", static_cast<bool>(pending_));
+  status.add("last outcome", last_outcome_);
+  if (!output_dir_.empty())
+    status.add("output", output_dir_);
+  if (!last_ok_)
+    status.summary(DiagnosticStatus::ERROR, "last cloud failed: " + last_outcome_);
+  else
+    status.summary(DiagnosticStatus::OK, busy_ ? "modeling" : last_outcome_);
 }
 
 }  // namespace ros_layer

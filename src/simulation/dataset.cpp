@@ -47,6 +47,15 @@ std::string viewName(int index) {
 
 }  // namespace
 
+Eigen::Isometry3d randomPlatformError(Rng& rng, double max_translation, double max_yaw_deg) {
+  const double r = max_translation * std::sqrt(rng.uniform());
+  const double a = rng.uniform(0.0, 2.0 * M_PI);
+  const double yaw = rng.uniform(-1.0, 1.0) * max_yaw_deg * M_PI / 180.0;
+  // Evaluated in this order so a seed gives the same error on every compiler.
+  const double z = rng.uniform(-0.05, 0.05);
+  return acquisition::platformPose(r * std::cos(a), r * std::sin(a), z, yaw);
+}
+
 DatasetSummary writeDataset(const DatasetOptions& options, const std::string& dir) {
   const auto start = std::chrono::steady_clock::now();
   const Orchard orchard = generateOrchard(options.orchard, options.seed);
@@ -65,7 +74,6 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
 
   const RayCaster caster(orchard.scene);
   const Lms111Model model(caster, options.sensor);
-  constexpr double DEG = M_PI / 180.0;
 
   // One initial-guess error per platform position, in the platform's own frame (odometry or an
   // operator misjudging where the platform stands): slide moves between its views are exact.
@@ -76,11 +84,8 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
   DatasetSummary summary;
   for (const auto& v : plan) {
     while (static_cast<int>(guess_error.size()) <= v.platform_index) {
-      const double r = options.guess_max_translation * std::sqrt(guess_rng.uniform());
-      const double a = guess_rng.uniform(0.0, 2.0 * M_PI);
-      const double yaw = guess_rng.uniform(-1.0, 1.0) * options.guess_max_yaw_deg * DEG;
-      guess_error.push_back(acquisition::platformPose(r * std::cos(a), r * std::sin(a),
-                                                      guess_rng.uniform(-0.05, 0.05), yaw));
+      guess_error.push_back(
+          randomPlatformError(guess_rng, options.guess_max_translation, options.guess_max_yaw_deg));
     }
     const Eigen::Isometry3d stage = acquisition::stagePose(v.platform, options.geometry, v.slide);
     const Eigen::Isometry3d guess_stage = acquisition::stagePose(

@@ -18,13 +18,19 @@ VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOption
   const double period = 1.0 / o.scan_frequency_hz;
   aerotech::EnsembleServer* stage = stage_.get();
   auto ensemble = ensemble_;
-  const Eigen::Isometry3d platform = o.platform;
+  setPlatform(o.platform);
+  std::shared_ptr<PlatformState> state = platform_;
   const acquisition::StageGeometry geometry = o.geometry;
   // The middle beam (135 of the mirror's 360 deg after the first ray) looks at the tree.
-  auto pose = [stage, ensemble, platform, geometry, period](double) {
+  auto pose = [stage, ensemble, state, geometry, period](double) {
     const double t = stage->now() + 0.375 * period;
     const double theta = ensemble->position("X", t) * M_PI / 180.0;
     const double slide_m = ensemble->position("Y", t) / 1000.0;
+    Eigen::Isometry3d platform;
+    {
+      std::lock_guard<std::mutex> lock(state->mutex);
+      platform = state->pose;
+    }
     return acquisition::laserPose(acquisition::stagePose(platform, geometry, slide_m), geometry,
                                   theta);
   };
@@ -33,6 +39,18 @@ VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOption
   device.scan.frequency = device.scan.resolution = o.scan_frequency_hz == 25.0 ? 2500 : 5000;
   laser_ = std::make_unique<lms111::EmulatorServer>(
       std::make_shared<lms111::EmulatedLms111>(device, source, o.laser_faults), o.laser);
+}
+
+void VirtualPlatform::setPlatform(const Eigen::Isometry3d& platform) {
+  if (!platform.matrix().allFinite())
+    throw Error(ErrorCode::INVALID_ARGUMENT, "the platform pose is not finite");
+  std::lock_guard<std::mutex> lock(platform_->mutex);
+  platform_->pose = platform;
+}
+
+Eigen::Isometry3d VirtualPlatform::platform() const {
+  std::lock_guard<std::mutex> lock(platform_->mutex);
+  return platform_->pose;
 }
 
 VirtualPlatform::~VirtualPlatform() {

@@ -217,3 +217,30 @@ TEST(TruthJson, ParseErrorInFileNamesThePath) {
 
 }  // namespace
 }  // namespace dormant_tree_modeling
+
+TEST(TransformModel, MovesCentresRotatesAxesKeepsSizes) {
+  modeling::TreeModel m;
+  modeling::CylinderModel trunk;
+  trunk.center = {1.0, 0.0, 0.5};
+  trunk.axis = {0.0, 0.0, 1.0};
+  trunk.diameter = 0.08;
+  m.trunk.push_back(trunk);
+  modeling::PrimaryBranch b;
+  b.cylinder.center = {1.2, 0.0, 0.8};
+  b.cylinder.axis = {1.0, 0.0, 0.0};
+  b.cylinder.diameter = 0.02;
+  b.measurement.attachment_height = 0.7;
+  m.primary_branches.push_back(b);
+  // A quarter turn about z, then 10 m along x.
+  Eigen::Isometry3d pose =
+      Eigen::Translation3d(10.0, 0.0, 0.0) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  const modeling::TreeModel t = modeling::transformModel(m, pose);
+  EXPECT_TRUE(t.trunk[0].center.isApprox(Eigen::Vector3d(10.0, 1.0, 0.5), 1e-12));
+  EXPECT_TRUE(t.trunk[0].axis.isApprox(Eigen::Vector3d(0.0, 0.0, 1.0), 1e-12));
+  EXPECT_TRUE(
+      t.primary_branches[0].cylinder.center.isApprox(Eigen::Vector3d(10.0, 1.2, 0.8), 1e-12));
+  EXPECT_NEAR(t.primary_branches[0].cylinder.axis.y(), 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(t.primary_branches[0].cylinder.diameter, 0.02);
+  EXPECT_DOUBLE_EQ(t.primary_branches[0].measurement.attachment_height, 0.7);
+  EXPECT_DOUBLE_EQ(t.trunk[0].diameter, 0.08);
+}

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct TreeModel {
   std::vector<PrimaryBranch> primary_branches;
   double runtime_s = 0.0;  ///< wall time of the modeler, s
 };
+
+/// @brief The model in another frame: centres moved, axes rotated by `pose` (a rigid
+/// transform, e.g. a tree frame into the orchard frame); sizes and measurements unchanged.
+TreeModel transformModel(const TreeModel& model, const Eigen::Isometry3d& pose);
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <std_srvs/Trigger.h>
@@ -20,10 +21,14 @@ namespace ros_layer {
 /// through the stage's `move_axis` (slide) and the assembler's `acquire_view`, asks the
 /// operator to move the platform (`~prompt`, std_msgs/String, latched; answered with
 /// `~platform_in_place`, std_srvs/Trigger, by the rviz user or a script), publishes the plan's
-/// platform pose as the tf `orchard -> platform` guess, shows progress on `~progress`
+/// platform pose as the tf `orchard -> platform` guess (and, before the move, as the goal
+/// `~platform_goal`, geometry_msgs/PoseStamped, for a driver or the virtual platform's
+/// operator), shows progress on `~progress`
 /// (std_msgs/String: views done, failed, time left), and records the raw topics of the tree into
 /// one rosbag (`~output_dir`/`~tree_name`.bag) with a Markdown report beside it. Services
 /// `~start` and `~cancel`; a cancelled or interrupted run closes the bag, so it stays usable.
+/// The final "finished: ..." progress goes into the bag too, so a replay knows the plan ended.
+/// Diagnostics: state, views done and failed, the bag, the last problem.
 class AcquisitionNode {
  public:
   /// @throws Error for a bad parameter or plan file
@@ -40,6 +45,7 @@ class AcquisitionNode {
   bool askForPlatform(const acquisition::PlannedView& view);
   void record(const std::string& topic, const topic_tools::ShapeShifter::ConstPtr& msg);
   void publish(ros::Publisher& pub, const std::string& text);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
   acquisition::ViewPlanConfig plan_;
@@ -50,7 +56,9 @@ class AcquisitionNode {
   int max_retries_;
   double drain_s_;  // wait for in-flight messages before the bag closes
 
-  ros::Publisher prompt_pub_, progress_pub_;
+  ros::Publisher prompt_pub_, progress_pub_, goal_pub_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::Timer diagnostics_timer_;
   ros::ServiceServer start_srv_, cancel_srv_, in_place_srv_;
   std::vector<ros::Subscriber> recorders_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
@@ -62,6 +70,8 @@ class AcquisitionNode {
   std::mutex mutex_;
   std::condition_variable wake_;
   bool in_place_ = false;
+  std::string state_ = "idle", last_problem_;
+  int done_ = 0, failed_ = 0, total_ = 0;
   std::atomic<bool> cancel_{false}, running_{false};
   std::thread worker_;
 };

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <sensor_msgs/JointState.h>
 #include <sensor_msgs/LaserScan.h>
@@ -7,10 +8,14 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
+#include <thread>
 
 #include "dormant_tree_modeling/acquisition/sweep_recorder.h"
+#include "dormant_tree_modeling/acquisition/sweep_watcher.h"
 #include "dormant_tree_modeling/acquisition/view_processing.h"
 
 namespace dormant_tree_modeling {
@@ -27,10 +32,18 @@ namespace ros_layer {
 /// (PointCloud2 in the platform frame, stamped at the sweep's middle, so the platform's pose
 /// at that time in tf is the view's pose guess) and `range_image` (sensor_msgs/Image 32FC1,
 /// m, a row per line). Parameters in config/scan_assembler.yaml.
+///
+/// With `~passive` (rosbag replay) it commands nothing: every continuous sweep seen in
+/// `joint_states` (from before one end of the θ range past the other) becomes a view, assembled
+/// on a worker thread from the same scans and positions, so a replay gives the views of the
+/// live run. Diagnostics: scans and views, failures, the last view.
 class ScanAssemblerNode {
  public:
   /// @throws Error INVALID_ARGUMENT for a bad parameter
   ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~ScanAssemblerNode();
+  ScanAssemblerNode(const ScanAssemblerNode&) = delete;
+  ScanAssemblerNode& operator=(const ScanAssemblerNode&) = delete;
 
  private:
   void scanCallback(const sensor_msgs::LaserScanConstPtr& msg);
@@ -38,6 +51,13 @@ class ScanAssemblerNode {
   bool acquireView(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   /// Runs the sweep; returns a summary or throws Error.
   std::string acquire();
+  /// Processes one assembled sweep into a view and publishes it; returns a summary or throws.
+  std::string publishView(acquisition::RangeImage image, std::size_t dropped, std::size_t missing,
+                          const ros::WallTime& started);
+  /// Passive mode: turns the watched sweeps into views.
+  void passiveLoop();
+  void noteOutcome(bool ok, const std::string& message);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void moveRotary(double target_deg, double velocity_deg_s);
   double lastScanPeriod();
 
@@ -55,6 +75,20 @@ class ScanAssemblerNode {
 
   std::unique_ptr<acquisition::SweepRecorder> recorder_;  // scans and stage positions
   std::mutex acquire_mutex_;                              // one sweep at a time
+  diagnostic_updater::Updater diagnostics_;
+  ros::Timer diagnostics_timer_;
+
+  bool passive_ = false;
+  std::unique_ptr<acquisition::SweepWatcher> watcher_;  // passive: sweeps in joint_states
+  std::mutex state_mutex_;
+  std::condition_variable wake_;
+  std::deque<acquisition::WatchedSweep> sweeps_;  // passive: waiting to be assembled
+  bool stop_ = false;
+  std::size_t scans_ = 0, views_ = 0, failures_ = 0;
+  double last_scan_wall_ = 0.0;
+  std::string last_outcome_ = "no view yet";
+  bool last_ok_ = true;
+  std::thread worker_;
 };
 
 }  // namespace ros_layer

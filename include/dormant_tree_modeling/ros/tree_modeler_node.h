@@ -1,11 +1,15 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <condition_variable>
 #include <mutex>
+#include <string>
 #include <thread>
 
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
@@ -20,7 +24,10 @@ namespace ros_layer {
 /// primaries green, pruning candidates red, each labelled with its diameter in cm) and
 /// `segments` (PointCloud2 of the modeled points with an `intensity` field: 0 other,
 /// 1 trunk, 2 primary branch). Service `~model_tree` (std_srvs/Trigger) models the last cloud
-/// again. Parameters: `~config_file` (YAML of ModelerConfig; empty: defaults).
+/// again. Parameters: `~config_file` (YAML of ModelerConfig; empty: defaults); `~output_dir`
+/// (optional: each model is also written there as model.json and cylinders.csv, in
+/// `~output_frame` when set, e.g. `orchard`, through tf, else in the cloud's frame).
+/// Diagnostics: models made and failed, the last outcome, whether a cloud is being modeled.
 /// Modeling runs on a worker thread; a cloud arriving while one is being modeled waits in a
 /// single slot, replacing (with a warning) any cloud already waiting there.
 class TreeModelerNode {
@@ -38,8 +45,18 @@ class TreeModelerNode {
   void workerLoop();
   /// Models one cloud and publishes; returns a one-line summary or throws Error.
   std::string process(const sensor_msgs::PointCloud2& msg);
+  /// Publishes the model, markers and segments (and writes the files); returns a summary.
+  std::string publish(const modeling::ModelResult& result, const std_msgs::Header& header);
+  void writeFiles(const modeling::TreeModel& model, const std_msgs::Header& header);
+  void noteOutcome(bool ok, const std::string& message);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   modeling::TreeModeler modeler_;
+  std::string output_dir_, output_frame_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_{tf_buffer_};
+  diagnostic_updater::Updater diagnostics_;
+  ros::Timer diagnostics_timer_;
   ros::Subscriber cloud_sub_;
   ros::Publisher model_pub_, marker_pub_, segments_pub_;
   ros::ServiceServer model_srv_;
@@ -49,6 +66,9 @@ class TreeModelerNode {
   sensor_msgs::PointCloud2ConstPtr pending_;  // waiting to be modeled
   sensor_msgs::PointCloud2ConstPtr last_;     // last cloud received, for ~model_tree
   bool stop_ = false;
+  bool busy_ = false, last_ok_ = true;
+  std::size_t models_ = 0, failures_ = 0;
+  std::string last_outcome_ = "no cloud yet";
   std::thread worker_;
 };
 

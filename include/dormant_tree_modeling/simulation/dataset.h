@@ -5,6 +5,7 @@
 
 #include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/acquisition/view_plan.h"
+#include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/simulation/lms111_model.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 
@@ -35,6 +36,11 @@ struct DatasetSummary {
   int primary_branches = 0;
   double simulate_seconds = 0.0;
 };
+
+/// @brief A random error of a platform position, in the platform's own frame (an operator or
+/// odometry misjudging where the platform stands): horizontal offset uniform over a disc of
+/// radius max_translation (m), height within ±5 cm, heading uniform within ±max_yaw_deg.
+Eigen::Isometry3d randomPlatformError(Rng& rng, double max_translation, double max_yaw_deg);
 
 /// @brief Generate the orchard, simulate every view of the plan and write, into `dir`:
 /// scene.json, truth.json, views.json (true and initial-guess poses),

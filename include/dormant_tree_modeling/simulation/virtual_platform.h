@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "dormant_tree_modeling/acquisition/stage_kinematics.h"
@@ -43,9 +44,20 @@ class VirtualPlatform {
   int laserPort() const { return laser_->colaAPort(); }
   int laserColaBPort() const { return laser_->colaBPort(); }
   int stagePort() const { return stage_->port(); }
+  /// @brief Move the platform (scene frame, as platformPose); scan lines after the call see
+  /// the new pose. Thread-safe.
+  void setPlatform(const Eigen::Isometry3d& platform);
+  /// @brief The platform's current pose in the scene frame.
+  Eigen::Isometry3d platform() const;
   void stop();
 
  private:
+  /// Read by the laser's scan thread, written by whoever drives the platform.
+  struct PlatformState {
+    mutable std::mutex mutex;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  };
+  std::shared_ptr<PlatformState> platform_ = std::make_shared<PlatformState>();
   std::shared_ptr<aerotech::EmulatedEnsemble> ensemble_;
   std::unique_ptr<aerotech::EnsembleServer> stage_;
   std::unique_ptr<lms111::EmulatorServer> laser_;

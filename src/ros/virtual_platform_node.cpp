@@ -1,0 +1,222 @@
+#include "dormant_tree_modeling/ros/virtual_platform_node.h"
+
+#include <std_srvs/Trigger.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/pose_json.h"
+#include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/simulation/dataset.h"
+#include "dormant_tree_modeling/simulation/orchard_generator.h"
+
+namespace dormant_tree_modeling {
+namespace ros_layer {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+
+int portParam(ros::NodeHandle& pnh, const std::string& name, int fallback) {
+  const int port = pnh.param(name, fallback);
+  if (port < -1 || port > 65535)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~" + name + " must be a port (0: any, -1: off)");
+  return port;
+}
+
+std::string describe(const Eigen::Isometry3d& pose) {
+  const Eigen::Vector3d t = pose.translation();
+  std::ostringstream s;
+  s.precision(3);
+  s << "x " << t.x() << " m, y " << t.y() << " m, z " << t.z() << " m, heading "
+    << std::atan2(pose.linear()(1, 0), pose.linear()(0, 0)) / DEG << " deg";
+  return s.str();
+}
+
+}  // namespace
+
+VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  simulation::VirtualPlatformOptions o;
+  o.laser.cola_a_port = portParam(pnh, "lms_port", 2111);
+  o.laser.cola_b_port = portParam(pnh, "lms_b_port", 2112);
+  o.stage_port = portParam(pnh, "aerotech_port", 8000);
+  o.scan_frequency_hz = pnh.param("frequency", 25.0);
+  const double noise_mm = pnh.param("noise_mm", 12.0);
+  if (!(noise_mm >= 0 && noise_mm <= 100))
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~noise_mm must be in 0..100 (mm, 1 sigma)");
+  o.range_noise_sigma = noise_mm / 1000.0;
+  const int seed = pnh.param("seed", 1);
+  if (seed < 0)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~seed must be >= 0");
+  o.seed = static_cast<std::uint64_t>(seed);
+  const std::vector<double> start =
+      pnh.param<std::vector<double>>("platform", {0.0, -1.5, 1.5, 90.0});
+  if (start.size() != 4)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~platform takes [x, y, z, yaw_deg]");
+  o.platform = acquisition::platformPose(start[0], start[1], start[2], start[3] * DEG);
+  o.stage_faults.fault_axis = pnh.param<std::string>("fault_axis", "");
+  o.stage_faults.fault_on_move = pnh.param("fault_on_move", 0);
+  scene_frame_ = pnh.param<std::string>("scene_frame", "orchard");
+  output_dir_ = pnh.param<std::string>("output_dir", "");
+  in_place_service_ = pnh.param<std::string>("in_place_service", "/acquisition/platform_in_place");
+  placement_error_ = pnh.param("placement_error", 0.2);
+  placement_error_yaw_deg_ = pnh.param("placement_error_yaw", 8.0);
+  settle_s_ = pnh.param("settle_time", 0.5);
+  if (!(placement_error_ >= 0 && placement_error_ <= 2 && placement_error_yaw_deg_ >= 0 &&
+        placement_error_yaw_deg_ <= 180 && settle_s_ >= 0 && settle_s_ <= 60))
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "need 0 <= ~placement_error <= 2 m, 0 <= ~placement_error_yaw <= 180 deg, "
+                "0 <= ~settle_time <= 60 s");
+  placement_rng_ = Rng::derive(o.seed, 17);
+
+  const std::string scene_file = pnh.param<std::string>("scene_file", "");
+  const std::string preset = pnh.param<std::string>("preset", "young_tall_spindle");
+  simulation::Scene scene;
+  std::string truth_json;
+  if (!scene_file.empty()) {
+    scene = simulation::loadScene(scene_file);
+    // synth_tree writes the truth beside the scene.
+    const auto truth = std::filesystem::path(scene_file).parent_path() / "truth.json";
+    if (std::filesystem::exists(truth))
+      truth_json = io::readTextFile(truth.string());
+  } else {
+    simulation::OrchardConfig orchard;
+    orchard.preset = preset;
+    simulation::Orchard generated = simulation::generateOrchard(orchard, o.seed);
+    scene = std::move(generated.scene);
+    truth_json = io::truthToJson(generated.truth);
+  }
+  if (!output_dir_.empty()) {
+    std::filesystem::create_directories(output_dir_);
+    simulation::saveScene(scene, output_dir_ + "/scene.json");
+    if (!truth_json.empty())
+      io::writeTextFile(output_dir_ + "/truth.json", truth_json);
+  }
+  platform_ = std::make_unique<simulation::VirtualPlatform>(scene, o);
+
+  pose_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_pose", 1, true);
+  move_srv_ = pnh.advertiseService("move_platform", &VirtualPlatformNode::movePlatform, this);
+  if (pnh.param("follow_goals", false)) {
+    goal_sub_ = nh.subscribe(pnh.param<std::string>("goal_topic", "/acquisition/platform_goal"), 10,
+                             &VirtualPlatformNode::goalCallback, this);
+  }
+  place(o.platform, nullptr);
+  diagnostics_.setHardwareID("virtual platform");
+  diagnostics_.add("virtual platform", this, &VirtualPlatformNode::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  ROS_INFO(
+      "virtual_platform: LMS111 on 127.0.0.1:%d (CoLa-A), %d (CoLa-B); Aerotech on "
+      "127.0.0.1:%d; %s; platform at %s%s",
+      platform_->laserPort(), platform_->laserColaBPort(), platform_->stagePort(),
+      scene_file.empty() ? ("preset " + preset + ", seed " + std::to_string(seed)).c_str()
+                         : scene_file.c_str(),
+      describe(o.platform).c_str(),
+      goal_sub_ ? ("; following goals on " + goal_sub_.getTopic()).c_str() : "");
+}
+
+VirtualPlatformNode::~VirtualPlatformNode() {
+  if (platform_)
+    platform_->stop();
+}
+
+void VirtualPlatformNode::place(const Eigen::Isometry3d& pose, const Eigen::Isometry3d* goal) {
+  platform_->setPlatform(pose);
+  geometry_msgs::PoseStamped msg;
+  msg.header.stamp = ros::Time::now();
+  msg.header.frame_id = scene_frame_;
+  msg.pose = tf2::toMsg(pose);
+  pose_pub_.publish(msg);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++moves_;
+  nlohmann::json entry{{"true_pose", io::poseToJson(pose)}};
+  if (goal)
+    entry["goal_pose"] = io::poseToJson(*goal);
+  log_.push_back(entry.dump());
+  writeLog();
+}
+
+void VirtualPlatformNode::writeLog() {
+  if (output_dir_.empty())
+    return;
+  std::string text = "{\n  \"frame\": \"" + scene_frame_ +
+                     "\",\n  \"pose\": \"platform frame in the scene\",\n  \"placements\": [";
+  for (std::size_t i = 0; i < log_.size(); ++i)
+    text += (i ? ",\n    " : "\n    ") + log_[i];
+  text += "\n  ]\n}\n";
+  try {
+    io::writeTextFile(output_dir_ + "/platform.json", text);
+  } catch (const Error& e) {
+    last_problem_ = e.what();
+    ROS_ERROR_THROTTLE(10.0, "virtual_platform: %s", e.what());
+  }
+}
+
+bool VirtualPlatformNode::movePlatform(dormant_tree_modeling::MovePlatform::Request& req,
+                                       dormant_tree_modeling::MovePlatform::Response& res) {
+  try {
+    const Eigen::Isometry3d pose = acquisition::platformPose(req.x, req.y, req.z, req.yaw * DEG);
+    place(pose, nullptr);
+    res.success = true;
+    res.message = "platform at " + describe(pose);
+  } catch (const Error& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+void VirtualPlatformNode::goalCallback(const geometry_msgs::PoseStampedConstPtr& msg) {
+  Eigen::Isometry3d goal;
+  tf2::fromMsg(msg->pose, goal);
+  Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
+  int index;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    index = goals_++;
+  }
+  // The first position is where the orchard frame is: the operator's error starts after it.
+  if (index > 0)
+    error =
+        simulation::randomPlatformError(placement_rng_, placement_error_, placement_error_yaw_deg_);
+  try {
+    place(goal * error, &goal);
+  } catch (const Error& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = std::string("cannot drive to the goal: ") + e.what();
+    ROS_ERROR("virtual_platform: %s", last_problem_.c_str());
+    return;
+  }
+  ROS_INFO("virtual_platform: drove to position %d: %s (asked for %s)", index + 1,
+           describe(goal * error).c_str(), describe(goal).c_str());
+  ros::WallDuration(settle_s_).sleep();
+  std_srvs::Trigger in_place;
+  if (!ros::service::call(in_place_service_, in_place) || !in_place.response.success) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = "could not report the platform in place on " + in_place_service_;
+    ROS_ERROR("virtual_platform: %s", last_problem_.c_str());
+  }
+}
+
+void VirtualPlatformNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const Eigen::Isometry3d pose = platform_->platform();
+  std::lock_guard<std::mutex> lock(mutex_);
+  status.add("LMS111 CoLa-A port", platform_->laserPort());
+  status.add("LMS111 CoLa-B port", platform_->laserColaBPort());
+  status.add("Aerotech port", platform_->stagePort());
+  status.add("platform", describe(pose));
+  status.add("platform moves", moves_);
+  status.add("goals followed", goals_);
+  if (last_problem_.empty())
+    status.summary(DiagnosticStatus::OK, "serving on 127.0.0.1");
+  else
+    status.summary(DiagnosticStatus::WARN, last_problem_);
+}
+
+}  // namespace ros_layer
+}  // namespace dormant_tree_modeling
