@@ -25,7 +25,8 @@ foreach(test_source ${DTM_ROSTEST_NODES})
   target_include_directories(${test_name} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
   target_compile_definitions(${test_name} PRIVATE
     DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"
-    DTM_BIN_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
+    DTM_BIN_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}"
+    DTM_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   add_dependencies(tests ${test_name})
 endforeach()
 
@@ -49,4 +50,18 @@ file(GLOB DTM_ROSTESTS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/rostest/*.te
 foreach(launch_file ${DTM_ROSTESTS})
   file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${launch_file})
   add_rostest(${rel})
+endforeach()
+
+# Every launch file passes roslaunch-check (arguments resolve, nodes and packages exist).
+find_package(roslaunch REQUIRED)
+file(GLOB DTM_LAUNCH_FILES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/launch/*.launch)
+foreach(launch_file ${DTM_LAUNCH_FILES})
+  file(RELATIVE_PATH rel ${PROJECT_SOURCE_DIR} ${launch_file})
+  if(rel STREQUAL "launch/model_file.launch")
+    roslaunch_add_file_check(${rel} file:=tree.pcd)
+  elseif(rel STREQUAL "launch/replay.launch")
+    roslaunch_add_file_check(${rel} bag:=tree.bag)
+  else()
+    roslaunch_add_file_check(${rel})
+  endif()
 endforeach()

@@ -187,10 +187,14 @@ std::string TreeModelerNode::publish(const modeling::ModelResult& result,
 void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const std_msgs::Header& header) {
   modeling::TreeModel out = model;
   if (!output_frame_.empty() && output_frame_ != header.frame_id) {
+    // Waits in wall time: in a replay the bag may have ended and sim time stopped.
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(2.0);
+    while (!tf_buffer_.canTransform(output_frame_, header.frame_id, header.stamp) &&
+           ros::WallTime::now() < give_up)
+      ros::WallDuration(0.02).sleep();
     try {
-      out = modeling::transformModel(
-          model, tf2::transformToEigen(tf_buffer_.lookupTransform(
-                     output_frame_, header.frame_id, header.stamp, ros::Duration(2.0))));
+      out = modeling::transformModel(model, tf2::transformToEigen(tf_buffer_.lookupTransform(
+                                                output_frame_, header.frame_id, header.stamp)));
     } catch (const tf2::TransformException& e) {
       throw Error(ErrorCode::IO_FAILURE, "the model was published but not written: no transform " +
                                              output_frame_ + " <- " + header.frame_id + ": " +

@@ -9,36 +9,16 @@
 
 #include <filesystem>
 
-#include "dormant_tree_modeling/io/point_cloud_io.h"
-#include "dormant_tree_modeling/ros/conversions.h"
-#include "dormant_tree_modeling/simulation/dataset.h"
+#include "synthetic_tree.h"
 
 namespace {
 
 using namespace dormant_tree_modeling;
 
-/// A synthetic tree from 8 views of the plan, as the registration would publish it.
-sensor_msgs::PointCloud2 syntheticTree() {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("dtm_rostest_" + std::to_string(getpid()));
-  simulation::DatasetOptions o;
-  o.seed = 3;
-  o.sensor.range_noise_sigma = 0.006;
-  o.plan.heights = {1.5, 3.0};
-  o.plan.positions_per_height = 1;
-  o.plan.slide_steps = 2;
-  o.plan.slide_step = 0.2;
-  o.write_views = false;
-  simulation::writeDataset(o, dir.string());
-  const auto cloud = io::readCloud((dir / "target.pcd").string());
-  std::filesystem::remove_all(dir);
-  return ros_layer::toMsg(*cloud.cloud, "tree", ros::Time::now());
-}
-
 TEST(TreeModelerNode, PublishesModelMarkersAndSegments) {
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("tree_cloud", 1, true);
-  pub.publish(syntheticTree());
+  pub.publish(test::syntheticTree("tree"));
   const auto model = ros::topic::waitForMessage<dormant_tree_modeling::TreeModel>(
       "tree_model", nh, ros::Duration(90.0));
   ASSERT_TRUE(model) << "no TreeModel within 90 s";
