@@ -62,11 +62,17 @@ void IsolationConfig::validate() const {
     if (!ok)
       throw Error(ErrorCode::INVALID_ARGUMENT, std::string("target isolation: ") + m);
   };
-  require(ground_margin >= 0 && ground_min_fraction >= 0 && ground_min_fraction < 1,
-          "ground_margin >= 0 and 0 <= ground_min_fraction < 1");
+  require(ground_margin >= 0 && ground_min_fraction >= 0 && ground_min_fraction < 1 &&
+              ground_hint_tolerance > 0,
+          "ground_margin >= 0, 0 <= ground_min_fraction < 1, ground_hint_tolerance > 0");
   require(trunk_band_low < trunk_band_high, "trunk_band_low < trunk_band_high");
   require(cell > 0 && component_cell > 0, "cell sizes must be > 0");
   require(hint_sigma > 0, "hint_sigma must be > 0");
+  require(candidate_ratio > 0 && candidate_ratio <= 1 && max_candidates >= 1,
+          "0 < candidate_ratio <= 1 and max_candidates >= 1");
+  require(branch_ring_inner >= 0 && branch_ring_outer > branch_ring_inner &&
+              branch_ring_high > branch_ring_low,
+          "branch_ring_inner < branch_ring_outer and branch_ring_low < branch_ring_high");
   require(min_distance >= 0 && max_distance > min_distance, "0 <= min_distance < max_distance");
   require(crop_radius > 0 && max_height > 0, "crop_radius and max_height must be > 0");
   require(trunk_clearance > 0 && other_column_radius > 0,
@@ -75,7 +81,7 @@ void IsolationConfig::validate() const {
 
 IsolationResult isolateTarget(const Cloud& cloud, const Eigen::Vector3d& sensor,
                               const Eigen::Vector3d& forward_in, const Eigen::Vector2d& hint,
-                              const IsolationConfig& c) {
+                              const IsolationConfig& c, std::optional<double> ground_hint) {
   c.validate();
   if (cloud.empty())
     throw Error(ErrorCode::EMPTY_INPUT, "target isolation: the view is empty");
@@ -85,6 +91,11 @@ IsolationResult isolateTarget(const Cloud& cloud, const Eigen::Vector3d& sensor,
   forward.normalize();
   IsolationResult out;
   out.ground_found = groundLevel(cloud, c, out.ground_z);
+  if (ground_hint && std::isfinite(*ground_hint) &&
+      (!out.ground_found || std::abs(out.ground_z - *ground_hint) > c.ground_hint_tolerance)) {
+    out.ground_found = out.ground_from_plan = true;
+    out.ground_z = *ground_hint;
+  }
   const double base = out.ground_found ? out.ground_z : -INFINITY;
 
   // Trunk: the best-scoring column of the band, counts smoothed over 3 x 3 cells.
@@ -100,7 +111,11 @@ IsolationResult isolateTarget(const Cloud& cloud, const Eigen::Vector3d& sensor,
     if (inBand(p))
       ++counts[key(p.x, p.y)];
   }
-  double best_score = 0.0;
+  struct Candidate {
+    double score;
+    Eigen::Vector2d centre;
+  };
+  std::vector<Candidate> candidates;
   for (const auto& [k, n] : counts) {
     const double cx = (static_cast<double>(k >> 32) + 0.5) * c.cell;
     const double cy =
@@ -117,14 +132,41 @@ IsolationResult isolateTarget(const Cloud& cloud, const Eigen::Vector3d& sensor,
         sum += it == counts.end() ? 0 : it->second;
       }
     }
-    const double score = sum * std::exp(-0.5 * std::pow(off / c.hint_sigma, 2));
-    if (score > best_score) {
-      best_score = score;
-      out.trunk = Eigen::Vector2d(cx, cy);
+    candidates.push_back({sum * std::exp(-0.5 * std::pow(off / c.hint_sigma, 2)), {cx, cy}});
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  if (candidates.empty() || candidates.front().score == 0.0)
+    throw Error(ErrorCode::EMPTY_INPUT, "target isolation: no tree ahead of the sensor");
+  // A trunk has branches around it; a post or a neighbour's trunk within the hint's reach has
+  // few (seen from high up, a thick post can hold more points of the band than the trunk).
+  const double best_band = candidates.front().score;
+  candidates.erase(
+      std::find_if(candidates.begin(), candidates.end(),
+                   [&](const Candidate& a) { return a.score < c.candidate_ratio * best_band; }),
+      candidates.end());
+  if (candidates.size() > c.max_candidates)
+    candidates.resize(c.max_candidates);
+  std::vector<std::size_t> ring(candidates.size(), 0);
+  if (out.ground_found && candidates.size() > 1) {
+    for (const auto& p : cloud) {
+      const double h = p.z - base;
+      if (h < c.branch_ring_low || h > c.branch_ring_high)
+        continue;
+      for (std::size_t i = 0; i < candidates.size(); ++i) {
+        const double r = (Eigen::Vector2d(p.x, p.y) - candidates[i].centre).norm();
+        ring[i] += r > c.branch_ring_inner && r < c.branch_ring_outer;
+      }
     }
   }
-  if (best_score == 0.0)
-    throw Error(ErrorCode::EMPTY_INPUT, "target isolation: no tree ahead of the sensor");
+  double best_score = -1.0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const double score = candidates[i].score * (1.0 + static_cast<double>(ring[i]));
+    if (score > best_score) {
+      best_score = score;
+      out.trunk = candidates[i].centre;
+    }
+  }
 
   // Other upright objects near the trunk (trellis posts, a neighbour's trunk): columns whose
   // points fill most of the band's height, away from the trunk. Branches cross the band;

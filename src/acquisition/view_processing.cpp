@@ -22,7 +22,8 @@ void ViewProcessingConfig::validate() const {
 }
 
 ProcessedView processView(RangeImage& image, const Eigen::Isometry3d& stage_in_frame,
-                          const Eigen::Vector2d& tree_hint, const ViewProcessingConfig& c) {
+                          const Eigen::Vector2d& tree_hint, const ViewProcessingConfig& c,
+                          std::optional<double> ground_hint) {
   c.validate();
   ProcessedView out;
   out.valid_pixels = image.validCount();
@@ -44,9 +45,9 @@ ProcessedView processView(RangeImage& image, const Eigen::Isometry3d& stage_in_f
     out.cloud = cloud;
     return out;
   }
-  out.isolation =
-      isolateTarget(*cloud, stage_in_frame.translation(),
-                    stage_in_frame.linear() * Eigen::Vector3d::UnitX(), tree_hint, c.isolation);
+  out.isolation = isolateTarget(*cloud, stage_in_frame.translation(),
+                                stage_in_frame.linear() * Eigen::Vector3d::UnitX(), tree_hint,
+                                c.isolation, ground_hint);
   out.cloud = out.isolation.cloud;
   return out;
 }

@@ -31,6 +31,10 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
   platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
   slide_centre_ = pnh.param("slide_centre", 0.3);
+  slide_velocity_ = pnh.param("slide_velocity", 0.0);
+  if (!(slide_velocity_ >= 0 && slide_velocity_ <= 1))
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "~slide_velocity must be in 0..1 m/s (0: the stage's default)");
   max_retries_ = pnh.param("max_retries", 2);
   drain_s_ = pnh.param("drain_seconds", 1.0);
   topics_ = pnh.param<std::vector<std::string>>(
@@ -154,6 +158,7 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   wake_.wait(lock, [&] { return in_place_ || cancel_ || !ros::ok(); });
   if (!in_place_)
     return false;
+  state_ = "scanning";  // still under the lock of the wait
   // The plan's pose is the registration's first guess for the views from here.
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = ros::Time::now();
@@ -168,10 +173,6 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   tf.transform.rotation.w = q.w();
   static_tf_.sendTransform(tf);
   publish(prompt_pub_, "platform at position " + std::to_string(view.platform_index + 1));
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    state_ = "scanning";
-  }
   return true;
 }
 
@@ -205,6 +206,7 @@ void AcquisitionNode::run() {
     dormant_tree_modeling::MoveAxis m;
     m.request.axis = slide_axis_;
     m.request.target = slide_centre_ + slide;
+    m.request.velocity = slide_velocity_;
     m.request.wait = true;
     if (!ros::service::call(move_service_, m))
       throw Error(ErrorCode::IO_FAILURE,

@@ -33,6 +33,7 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   rotary_joint_ = pnh.param<std::string>("rotary_joint", "rotary_stage_joint");
   move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
   platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
+  tree_frame_ = pnh.param<std::string>("tree_frame", "orchard");
   stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
   sweep_.theta_min = pnh.param("theta_min", sweep_.theta_min);
   sweep_.theta_max = pnh.param("theta_max", sweep_.theta_max);
@@ -212,6 +213,18 @@ std::string ScanAssemblerNode::acquire() {
   return publishView(std::move(image), dropped, missing, started);
 }
 
+Eigen::Vector3d ScanAssemblerNode::treeHint(const ros::Time& stamp) {
+  // Where the plan (the acquisition's orchard -> platform) puts the tree: its frame's origin,
+  // the base of the trunk on the ground.
+  if (!tree_frame_.empty() && tf_buffer_.canTransform(platform_frame_, tree_frame_, stamp)) {
+    const auto t = tf_buffer_.lookupTransform(platform_frame_, tree_frame_, stamp).transform;
+    return Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  }
+  ROS_WARN_ONCE("scan_assembler: no transform %s <- %s: the tree is assumed %.2f m straight ahead",
+                platform_frame_.c_str(), tree_frame_.c_str(), tree_distance_);
+  return Eigen::Vector3d(tree_distance_, 0.0, NAN);
+}
+
 std::string ScanAssemblerNode::publishView(acquisition::RangeImage image, std::size_t dropped,
                                            std::size_t missing, const ros::WallTime& started) {
   // A laser that dropped out mid-sweep leaves empty rows: fail the view so it is retried.
@@ -240,9 +253,10 @@ std::string ScanAssemblerNode::publishView(acquisition::RangeImage image, std::s
   std::memcpy(img.data.data(), image.range.data(), img.data.size());
   image_pub_.publish(img);
 
-  // The plan puts the trunk tree_distance ahead of the platform, on its axis.
+  const Eigen::Vector3d tree = treeHint(stamp);
   const acquisition::ProcessedView view = acquisition::processView(
-      image, stage_in_platform, Eigen::Vector2d(tree_distance_, 0.0), processing_);
+      image, stage_in_platform, tree.head<2>(), processing_,
+      std::isfinite(tree.z()) ? std::optional<double>(tree.z()) : std::nullopt);
   cloud_pub_.publish(toMsg(*view.cloud, platform_frame_, stamp));
   std::ostringstream m;
   m << image.rows << " x " << image.cols << " range image (" << missing << " rows without a line, "

@@ -1,6 +1,9 @@
 #include "dormant_tree_modeling/ros/tree_modeler_node.h"
 
 #include <dormant_tree_modeling/TreeModel.h>
+#include <pcl/common/transforms.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -10,6 +13,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/ros/model_messages.h"
@@ -156,6 +160,8 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
       ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
     const modeling::ModelResult result = modeler_.model(*cloud);
     const std::string summary = publish(result, msg.header);
+    if (!output_dir_.empty())
+      writeFiles(result.model, *cloud, msg.header);
     noteOutcome(true, summary);
     return summary;
   } catch (const Error& e) {
@@ -179,13 +185,13 @@ std::string TreeModelerNode::publish(const modeling::ModelResult& result,
   s << result.model.trunk.size() << " trunk cylinders, " << result.model.primary_branches.size()
     << " primary branches (" << prune << " to prune) from " << result.model.input_points
     << " points in " << result.model.runtime_s << " s";
-  if (!output_dir_.empty())
-    writeFiles(result.model, header);
   return s.str();
 }
 
-void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const std_msgs::Header& header) {
+void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const Cloud& cloud,
+                                 const std_msgs::Header& header) {
   modeling::TreeModel out = model;
+  Eigen::Isometry3d to_output = Eigen::Isometry3d::Identity();
   if (!output_frame_.empty() && output_frame_ != header.frame_id) {
     // Waits in wall time: in a replay the bag may have ended and sim time stopped.
     const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(2.0);
@@ -193,8 +199,9 @@ void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const std_msg
            ros::WallTime::now() < give_up)
       ros::WallDuration(0.02).sleep();
     try {
-      out = modeling::transformModel(model, tf2::transformToEigen(tf_buffer_.lookupTransform(
-                                                output_frame_, header.frame_id, header.stamp)));
+      to_output = tf2::transformToEigen(
+          tf_buffer_.lookupTransform(output_frame_, header.frame_id, header.stamp));
+      out = modeling::transformModel(model, to_output);
     } catch (const tf2::TransformException& e) {
       throw Error(ErrorCode::IO_FAILURE, "the model was published but not written: no transform " +
                                              output_frame_ + " <- " + header.frame_id + ": " +
@@ -203,6 +210,11 @@ void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const std_msg
   }
   io::writeTextFile(output_dir_ + "/model.json", io::modelToJson(out));
   io::writeTextFile(output_dir_ + "/cylinders.csv", io::cylindersToCsv(out));
+  // The cloud beside the model, in the same frame, for pictures and for checking the fit.
+  Cloud moved;
+  pcl::transformPointCloud(cloud, moved, to_output.cast<float>().matrix());
+  io::writeCloud(output_dir_ + "/cloud.pcd", moved);
+  io::writeCloud(output_dir_ + "/cloud.ply", moved);
 }
 
 void TreeModelerNode::noteOutcome(bool ok, const std::string& message) {

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+
 #include <Eigen/Geometry>
 
 #include "dormant_tree_modeling/acquisition/range_image.h"
@@ -33,9 +35,11 @@ struct ProcessedView {
 /// isolation. The image is modified (filtered) in place.
 /// @param stage_in_frame the rotary_stage frame in the output frame (z up)
 /// @param tree_hint where the plan expects the trunk, (x, y) in the output frame
+/// @param ground_hint the ground's height in the output frame as the plan knows it, if it does
 /// @throws Error EMPTY_INPUT for an image without valid pixels or without a tree
 ProcessedView processView(RangeImage& image, const Eigen::Isometry3d& stage_in_frame,
-                          const Eigen::Vector2d& tree_hint, const ViewProcessingConfig& config);
+                          const Eigen::Vector2d& tree_hint, const ViewProcessingConfig& config,
+                          std::optional<double> ground_hint = std::nullopt);
 
 }  // namespace acquisition
 }  // namespace dormant_tree_modeling

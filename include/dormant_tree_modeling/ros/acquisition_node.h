@@ -52,7 +52,7 @@ class AcquisitionNode {
   std::string output_dir_, tree_name_, move_service_, acquire_service_, slide_axis_;
   std::string orchard_frame_, platform_frame_;
   std::vector<std::string> topics_;
-  double slide_centre_;
+  double slide_centre_, slide_velocity_;  // m, m/s (0: the stage's default)
   int max_retries_;
   double drain_s_;  // wait for in-flight messages before the bag closes
 

@@ -54,6 +54,9 @@ class ScanAssemblerNode {
   /// Processes one assembled sweep into a view and publishes it; returns a summary or throws.
   std::string publishView(acquisition::RangeImage image, std::size_t dropped, std::size_t missing,
                           const ros::WallTime& started);
+  /// The target trunk's base as the plan expects it in the platform frame: the origin of
+  /// `~tree_frame` through tf when known, else `~tree_distance` straight ahead (z NaN).
+  Eigen::Vector3d treeHint(const ros::Time& stamp);
   /// Passive mode: turns the watched sweeps into views.
   void passiveLoop();
   void noteOutcome(bool ok, const std::string& message);
@@ -61,7 +64,8 @@ class ScanAssemblerNode {
   void moveRotary(double target_deg, double velocity_deg_s);
   double lastScanPeriod();
 
-  std::string rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_;
+  std::string rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_,
+      tree_frame_;
   acquisition::SweepSettings sweep_;
   double tree_distance_, max_missing_rows_;
   acquisition::ViewProcessingConfig processing_;

@@ -26,7 +26,8 @@ namespace ros_layer {
 /// 1 trunk, 2 primary branch). Service `~model_tree` (std_srvs/Trigger) models the last cloud
 /// again. Parameters: `~config_file` (YAML of ModelerConfig; empty: defaults); `~output_dir`
 /// (optional: each model is also written there as model.json and cylinders.csv, in
-/// `~output_frame` when set, e.g. `orchard`, through tf, else in the cloud's frame).
+/// `~output_frame` when set, e.g. `orchard`, through tf, else in the cloud's frame), with the
+/// cloud it was made from as cloud.pcd and cloud.ply in the same frame.
 /// Diagnostics: models made and failed, the last outcome, whether a cloud is being modeled.
 /// Modeling runs on a worker thread; a cloud arriving while one is being modeled waits in a
 /// single slot, replacing (with a warning) any cloud already waiting there.
@@ -47,7 +48,8 @@ class TreeModelerNode {
   std::string process(const sensor_msgs::PointCloud2& msg);
   /// Publishes the model, markers and segments (and writes the files); returns a summary.
   std::string publish(const modeling::ModelResult& result, const std_msgs::Header& header);
-  void writeFiles(const modeling::TreeModel& model, const std_msgs::Header& header);
+  void writeFiles(const modeling::TreeModel& model, const Cloud& cloud,
+                  const std_msgs::Header& header);
   void noteOutcome(bool ok, const std::string& message);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
