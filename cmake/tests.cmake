@@ -65,3 +65,15 @@ foreach(launch_file ${DTM_LAUNCH_FILES})
     roslaunch_add_file_check(${rel})
   endif()
 endforeach()
+
+# The whole-system tests run every node; the rviz test runs the modeler.
+if(TARGET test_end_to_end)
+  add_dependencies(test_end_to_end virtual_platform lms111_driver stage_controller scan_assembler
+                   acquisition registration tree_modeler)
+endif()
+if(TARGET test_replay)
+  add_dependencies(test_replay scan_assembler registration tree_modeler)
+endif()
+if(TARGET test_rviz_screenshot)
+  add_dependencies(test_rviz_screenshot tree_modeler)
+endif()

@@ -53,7 +53,8 @@ roslaunch dormant_tree_modeling demo.launch preset:="$preset" seed:="$seed" nois
 launch_pid=$!
 pids+=($launch_pid)
 
-progress() { timeout 5 rostopic echo -n1 "$1" 2>/dev/null | sed -n 's/^data: "\{0,1\}//p' | sed 's/"$//'; }
+# The latest message of a std_msgs/String topic, on one line.
+progress() { timeout 5 rostopic echo -n1 -p "$1" 2>/dev/null | sed -n '2s/^[^,]*,//p'; }
 last=""
 model="$run/model/model.json"
 while [[ ! -f "$model" ]]; do
@@ -74,7 +75,8 @@ while [[ ! -f "$model" ]]; do
   sleep 5
 done
 sleep 1  # the modeler writes model.json first, then the CSV and the clouds
-say "registration: $(progress /registration/report | head -c 200 | tr '\n' ' ')"
+reg_dir="$(ls -d "$run"/registration/*/ 2>/dev/null | tail -1)"
+[[ -n "$reg_dir" ]] && say "registration: $(grep -m1 'views registered' "$reg_dir/registration.md")"
 say "model written: $(grep -c '^primary_branch' "$run/model/cylinders.csv") primary branches"
 
 picture_note="not taken (no Xvfb/rviz/ImageMagick)"
@@ -89,7 +91,6 @@ stop_all
 cp "$run/model/model.json" "$run/model/cylinders.csv" "$run/truth/truth.json" "$out/"
 cp "$run/model/cloud.pcd" "$out/registered.pcd"
 cp "$run/model/cloud.ply" "$out/registered.ply"
-reg_dir="$(ls -d "$run"/registration/*/ 2>/dev/null | tail -1)"
 [[ -n "$reg_dir" ]] && cp "$reg_dir/registration.md" "$out/registration.md"
 cp "$run/$tree"_report.md "$out/acquisition.md" 2>/dev/null
 "$bin/render_model" "$out/registered.pcd" "$out/model.json" --output "$out/model.png"
