@@ -3,7 +3,7 @@
 # synthetic tree with the paper's 40-view plan, registers the views and models the tree; the
 # results are gathered in results/<tree>/ and scored against the ground truth.
 #   DEMO_PRESET (young_tall_spindle), DEMO_SEED (1), DEMO_NOISE_MM (6) choose the tree;
-#   DEMO_GUI=1 opens rviz when there is a display; DEMO_TIMEOUT (900 s) bounds the run.
+#   rviz opens when there is a display (DEMO_GUI=0: never); DEMO_TIMEOUT (900 s) bounds the run.
 set -uo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bin="$root/.build/devel/lib/dormant_tree_modeling"
@@ -15,7 +15,7 @@ tree="${preset}_seed${seed}"
 out="$root/results/$tree"
 run="$out/run"
 gui=false
-[[ "${DEMO_GUI:-0}" == 1 && -n "${DISPLAY:-}" ]] && gui=true
+[[ "${DEMO_GUI:-1}" != 0 && -n "${DISPLAY:-}" ]] && gui=true
 start=$(date +%s)
 elapsed() { echo $(($(date +%s) - start)); }
 say() { printf '[%4d s] %s\n' "$(elapsed)" "$*"; }
