@@ -200,6 +200,33 @@ TEST(TargetIsolation, HighViewsBesideTheTreeWithTheOperatorsError) {
   }
 }
 
+TEST(TargetIsolation, TakesThePlansGroundWhenNoneIsSeen) {
+  // No ground in the scene (a view over tall grass or snow that returns nothing): the trunk
+  // band is placed from the plan's ground level, so posts and neighbours are still cut out.
+  simulation::OrchardConfig oc;
+  oc.ground = false;
+  const simulation::Orchard orchard = simulation::generateOrchard(oc, 1);
+  const LabelledView v = labelledView(orchard, platformPose(0.0, -1.5, 4.0, M_PI / 2), 1);
+  const IsolationResult without =
+      isolateTarget(v.cloud, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), {1.5, 0.0}, {});
+  const IsolationResult with = isolateTarget(v.cloud, Eigen::Vector3d::Zero(),
+                                             Eigen::Vector3d::UnitX(), {1.5, 0.0}, {}, -4.0);
+  EXPECT_FALSE(without.ground_found);
+  ASSERT_TRUE(with.ground_found);
+  EXPECT_TRUE(with.ground_from_plan);
+  EXPECT_DOUBLE_EQ(with.ground_z, -4.0);
+  EXPECT_NEAR(with.trunk.x(), 1.5, 0.1);
+  EXPECT_NEAR(with.trunk.y(), 0.0, 0.1);
+  const auto [recall, precision] = recallPrecision(v, with);
+  const auto [recall0, precision0] = recallPrecision(v, without);
+  std::printf(
+      "[ INFO ] no ground: recall %.3f, precision %.3f with the plan's ground; %.3f, %.3f "
+      "without\n",
+      recall, precision, recall0, precision0);
+  EXPECT_GT(recall, 0.8);
+  EXPECT_GT(precision, 0.75);
+}
+
 TEST(TargetIsolation, CutsTheTargetTreeOutOfOrchardViews) {
   // One front view per preset, at trunk height, 1.5 m in front of the tree: neighbours in the
   // row 0.9-1.2 m to the sides, a trellis post, wires, the next rows, the ground.
@@ -209,48 +236,17 @@ TEST(TargetIsolation, CutsTheTargetTreeOutOfOrchardViews) {
     simulation::OrchardConfig oc;
     oc.preset = preset;
     const simulation::Orchard orchard = simulation::generateOrchard(oc, seed);
-    const simulation::RayCaster caster(orchard.scene);
-    simulation::Lms111Config sensor;
-    sensor.angular_resolution_deg = 0.5;
-    sensor.scan_frequency_hz = 50.0;
-    const simulation::Lms111Model model(caster, sensor);
-    const Eigen::Isometry3d platform = platformPose(0.0, -1.5, 1.5, M_PI / 2);
-    const StageGeometry geometry;
-    ViewPlanConfig sweep;
-    sweep.theta_step_deg = 0.9;
-    const simulation::SimulatedView view = simulation::simulateView(
-        model, stagePose(platform, geometry, 0.0), geometry, sweep, seed, 0, 2);
-    // Stage-frame points, remembering which belong to the target tree.
-    Cloud cloud;
-    std::set<std::tuple<float, float, float>> target;
-    for (int i = 0; i < view.image.rows; ++i) {
-      for (int j = 0; j < view.image.cols; ++j) {
-        const float rho = view.image.at(i, j);
-        if (!(rho > 0.0f) || view.image.phi(j) >= M_PI)
-          continue;
-        double x, y, z;
-        sphericalToCartesian(rho, view.image.theta(i), view.image.phi(j), x, y, z);
-        const pcl::PointXYZ p(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
-        cloud.push_back(p);
-        const auto& label = view.labels[static_cast<std::size_t>(i) * view.image.cols + j];
-        if (label.object == 0 && label.part <= simulation::Part::MINOR)
-          target.insert({p.x, p.y, p.z});
-      }
-    }
+    const LabelledView v = labelledView(orchard, platformPose(0.0, -1.5, 1.5, M_PI / 2), seed);
     const IsolationResult r =
-        isolateTarget(cloud, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
+        isolateTarget(v.cloud, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
                       Eigen::Vector2d(1.5, 0.0), IsolationConfig{});
     EXPECT_TRUE(r.ground_found) << preset;
     EXPECT_NEAR(r.ground_z, -1.5, 0.05) << preset;  // the platform frame is at laser height
     EXPECT_NEAR(r.trunk.x(), 1.5, 0.1) << preset;   // the trunk, 1.5 m ahead on the axis
     EXPECT_NEAR(r.trunk.y(), 0.0, 0.1) << preset;
-    std::size_t kept_target = 0;
-    for (const auto& p : *r.cloud)
-      kept_target += target.count({p.x, p.y, p.z});
-    const double recall = static_cast<double>(kept_target) / target.size();
-    const double precision = static_cast<double>(kept_target) / r.cloud->size();
+    const auto [recall, precision] = recallPrecision(v, r);
     std::printf("[ INFO ] %s: %zu points, %zu on the tree; kept %zu: recall %.3f, precision %.3f\n",
-                preset, cloud.size(), target.size(), r.cloud->size(), recall, precision);
+                preset, v.cloud.size(), v.target.size(), r.cloud->size(), recall, precision);
     // A cylinder of crop_radius loses the outer tips of wide trees (central leader: 0.84).
     EXPECT_GT(recall, 0.8) << preset;
     EXPECT_GT(precision, 0.75) << preset;
