@@ -11,7 +11,7 @@ namespace dormant_tree_modeling {
 namespace ros_layer {
 
 CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string file;
+  std::string& file = file_;
   if (!pnh.getParam("file", file) || file.empty()) {
     throw Error(ErrorCode::INVALID_ARGUMENT, "parameter ~file is required (a .pcd, .ply or .xyz)");
   }
@@ -25,7 +25,10 @@ CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh
     ROS_WARN("%s: dropped %zu NaN/Inf points of %zu", file.c_str(), loaded.dropped_non_finite,
              loaded.points_in_file);
   }
+  dropped_ = loaded.dropped_non_finite;
   if (!loaded.offset.isZero()) {
+    offset_ = std::to_string(loaded.offset.x()) + ", " + std::to_string(loaded.offset.y()) + ", " +
+              std::to_string(loaded.offset.z());
     ROS_INFO("%s: survey coordinates recentred; original = published + (%.3f, %.3f, %.3f)",
              file.c_str(), loaded.offset.x(), loaded.offset.y(), loaded.offset.z());
   }
@@ -33,6 +36,10 @@ CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh
   publisher_ = nh.advertise<sensor_msgs::PointCloud2>("cloud", 1, /*latch=*/true);
   ROS_INFO("publishing %zu points from %s in frame '%s'%s", loaded.cloud->size(), file.c_str(),
            frame_id.c_str(), rate > 0.0 ? "" : " (latched, once)");
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("cloud file", this, &CloudFilePublisher::diagnose);
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
   publish();
   if (rate > 0.0) {
     timer_ =
@@ -43,6 +50,17 @@ CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh
 void CloudFilePublisher::publish() {
   msg_.header.stamp = ros::Time::now();
   publisher_.publish(msg_);
+  ++published_;
+}
+
+void CloudFilePublisher::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  status.add("file", file_);
+  status.add("points", size());
+  status.add("NaN/Inf points dropped", dropped_);
+  status.add("survey offset (m)", offset_.empty() ? std::string("none") : offset_);
+  status.add("publications", published_);
+  status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                 "published " + std::to_string(size()) + " points");
 }
 
 }  // namespace ros_layer

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 
@@ -13,7 +14,8 @@ namespace ros_layer {
 /// Parameters (private): `file` (required), `frame_id` (default "orchard"),
 /// `rate` (Hz; 0 publishes once, latched; default 0).
 /// Topic: `cloud` (sensor_msgs/PointCloud2). Survey coordinates are recentred; the offset
-/// is logged so that results can be shifted back.
+/// is logged so that results can be shifted back. Diagnostics: the file, its points, the
+/// offset, publications.
 class CloudFilePublisher {
  public:
   /// @param nh node handle for topics
@@ -26,10 +28,14 @@ class CloudFilePublisher {
 
  private:
   void publish();
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::Publisher publisher_;
-  ros::Timer timer_;
+  ros::Timer timer_, diagnostics_timer_;
+  diagnostic_updater::Updater diagnostics_;
   sensor_msgs::PointCloud2 msg_;
+  std::string file_, offset_;
+  std::size_t dropped_ = 0, published_ = 0;
 };
 
 }  // namespace ros_layer
