@@ -215,9 +215,6 @@ TEST(TruthJson, ParseErrorInFileNamesThePath) {
   EXPECT_NE(msg.find("'trunk'"), std::string::npos) << msg;
 }
 
-}  // namespace
-}  // namespace dormant_tree_modeling
-
 TEST(TransformModel, MovesCentresRotatesAxesKeepsSizes) {
   modeling::TreeModel m;
   modeling::CylinderModel trunk;
@@ -244,3 +241,6 @@ TEST(TransformModel, MovesCentresRotatesAxesKeepsSizes) {
   EXPECT_DOUBLE_EQ(t.primary_branches[0].measurement.attachment_height, 0.7);
   EXPECT_DOUBLE_EQ(t.trunk[0].diameter, 0.08);
 }
+
+}  // namespace
+}  // namespace dormant_tree_modeling
