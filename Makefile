@@ -41,7 +41,8 @@ build: setup
 test: build
 	rm -rf $(BUILD)/cmake/test_results
 	$(MAKE) -C $(BUILD)/cmake -j$(JOBS) tests
-	-$(MAKE) -C $(BUILD)/cmake -j1 run_tests
+	# Debian's python3 first: ROS's scripts (roslaunch-check) start with "env python3".
+	-PATH=/usr/bin:$$PATH $(MAKE) -C $(BUILD)/cmake -j1 run_tests
 	$(PYTHON) scripts/test_summary.py $(BUILD)/cmake/test_results
 
 bench: build

@@ -5,7 +5,6 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <std_msgs/String.h>
 
-#include <algorithm>
 #include <boost/bind/bind.hpp>
 #include <cmath>
 #include <filesystem>
@@ -245,21 +244,28 @@ void AcquisitionNode::run() {
     last_problem_ = std::string("stopped: ") + e.what();
   }
   // Messages of the last view may still be in transit (the view cloud is published just
-  // before acquire_view returns): let them arrive before the bag closes, and the final
-  // progress with them, so a replay of the bag sees the plan end after its last view.
+  // before acquire_view returns): let them arrive before the bag closes.
   ros::WallDuration(drain_s_).sleep();
   const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
   const std::string summary = report.substr(0, report.find('\n'));
-  publish(progress_pub_, "finished: " + summary);
-  ros::WallDuration(std::min(drain_s_, 0.2)).sleep();
+  std_msgs::String finished;
+  finished.data = "finished: " + summary;
   {
     std::lock_guard<std::mutex> lock(bag_mutex_);
     recording_ = false;
+    // The bag ends with the plan's end, so a replay knows when the last view is in.
+    try {
+      bag_.write(progress_pub_.getTopic(), ros::Time::now(), finished);
+    } catch (const rosbag::BagException& e) {
+      ROS_ERROR("recording the end of the plan failed: %s", e.what());
+    }
     bag_.close();
   }
   std::ofstream(output_dir_ + "/" + tree_name_ + "_report.md")
       << "# Acquisition of " << tree_name_ << "\n\nBag: " << bag_path << "\n\n"
       << report;
+  // Only now: whoever hears "finished" may read the bag and the report at once.
+  progress_pub_.publish(finished);
   ROS_INFO("acquisition finished: %s", summary.c_str());
   {
     std::lock_guard<std::mutex> lock(mutex_);
