@@ -36,6 +36,7 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
                 "~slide_velocity must be in 0..1 m/s (0: the stage's default)");
   max_retries_ = pnh.param("max_retries", 2);
   drain_s_ = pnh.param("drain_seconds", 1.0);
+  service_wait_s_ = pnh.param("service_wait", 30.0);
   topics_ = pnh.param<std::vector<std::string>>(
       "record_topics", {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static",
                         "/assembler/view_cloud", "/acquisition/progress"});
@@ -45,6 +46,8 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
     throw Error(ErrorCode::INVALID_ARGUMENT, "~max_retries must be in 0..10");
   if (drain_s_ < 0 || drain_s_ > 60)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~drain_seconds must be in 0..60");
+  if (!(service_wait_s_ > 0 && service_wait_s_ <= 600))
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~service_wait must be in (0, 600] s");
   prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
   progress_pub_ = pnh.advertise<std_msgs::String>("progress", 1, true);
   goal_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_goal", 1, true);
@@ -207,15 +210,25 @@ void AcquisitionNode::run() {
     m.request.target = slide_centre_ + slide;
     m.request.velocity = slide_velocity_;
     m.request.wait = true;
-    if (!ros::service::call(move_service_, m))
-      throw Error(ErrorCode::IO_FAILURE,
-                  "the stage service " + move_service_ + " is not available");
-    if (!m.response.success)
-      throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
+    // At start-up the stage may still be connecting or homing: wait for it a while.
+    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(service_wait_s_);
+    while (true) {
+      if (!ros::service::waitForService(move_service_, ros::Duration(service_wait_s_)) ||
+          !ros::service::call(move_service_, m))
+        throw Error(ErrorCode::IO_FAILURE,
+                    "the stage service " + move_service_ + " is not available");
+      if (m.response.success)
+        return;
+      if (m.response.message.rfind("stage not ready", 0) != 0 || ros::WallTime::now() > give_up ||
+          cancel_)
+        throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
+      ros::WallDuration(0.5).sleep();
+    }
   };
   a.acquire_view = [this](const acquisition::PlannedView&) {
     std_srvs::Trigger t;
-    if (!ros::service::call(acquire_service_, t))
+    if (!ros::service::waitForService(acquire_service_, ros::Duration(service_wait_s_)) ||
+        !ros::service::call(acquire_service_, t))
       throw Error(ErrorCode::IO_FAILURE,
                   "the assembler service " + acquire_service_ + " is not available");
     if (!t.response.success)

@@ -54,7 +54,8 @@ class AcquisitionNode {
   std::vector<std::string> topics_;
   double slide_centre_, slide_velocity_;  // m, m/s (0: the stage's default)
   int max_retries_;
-  double drain_s_;  // wait for in-flight messages before the bag closes
+  double drain_s_;         // wait for in-flight messages before the bag closes
+  double service_wait_s_;  // for the stage's and the assembler's services (start-up)
 
   ros::Publisher prompt_pub_, progress_pub_, goal_pub_;
   diagnostic_updater::Updater diagnostics_;
