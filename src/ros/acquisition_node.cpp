@@ -4,6 +4,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <std_msgs/String.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <boost/bind/bind.hpp>
 #include <cmath>
@@ -145,14 +146,7 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   geometry_msgs::PoseStamped goal;
   goal.header.stamp = ros::Time::now();
   goal.header.frame_id = orchard_frame_;
-  goal.pose.position.x = t.x();
-  goal.pose.position.y = t.y();
-  goal.pose.position.z = t.z();
-  const Eigen::Quaterniond q(view.platform.linear());
-  goal.pose.orientation.x = q.x();
-  goal.pose.orientation.y = q.y();
-  goal.pose.orientation.z = q.z();
-  goal.pose.orientation.w = q.w();
+  goal.pose = tf2::toMsg(view.platform);
   goal_pub_.publish(goal);
   publish(prompt_pub_, m.str());
   ROS_INFO("%s", m.str().c_str());
@@ -162,17 +156,10 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
     return false;
   state_ = "scanning";  // still under the lock of the wait
   // The plan's pose is the registration's first guess for the views from here.
-  geometry_msgs::TransformStamped tf;
+  geometry_msgs::TransformStamped tf = tf2::eigenToTransform(view.platform);
   tf.header.stamp = ros::Time::now();
   tf.header.frame_id = orchard_frame_;
   tf.child_frame_id = platform_frame_;
-  tf.transform.translation.x = t.x();
-  tf.transform.translation.y = t.y();
-  tf.transform.translation.z = t.z();
-  tf.transform.rotation.x = q.x();
-  tf.transform.rotation.y = q.y();
-  tf.transform.rotation.z = q.z();
-  tf.transform.rotation.w = q.w();
   static_tf_.sendTransform(tf);
   publish(prompt_pub_, "platform at position " + std::to_string(view.platform_index + 1));
   return true;

@@ -138,8 +138,7 @@ void TreeModelerNode::workerLoop() {
       pending_.reset();
     }
     try {
-      const std::string summary = process(*cloud);
-      ROS_INFO("tree_modeler: %s", summary.c_str());
+      ROS_INFO("tree_modeler: %s", process(*cloud).c_str());
     } catch (const Error& e) {
       ROS_ERROR("tree_modeler: %s: %s", errorCodeName(e.code()), e.what());
     } catch (const std::exception& e) {

@@ -13,6 +13,7 @@
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
+#include "dormant_tree_modeling/simulation/scene.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -75,28 +76,15 @@ VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& p
 
   const std::string scene_file = pnh.param<std::string>("scene_file", "");
   const std::string preset = pnh.param<std::string>("preset", "young_tall_spindle");
-  simulation::Scene scene;
-  std::string truth_json;
-  if (!scene_file.empty()) {
-    scene = simulation::loadScene(scene_file);
-    // synth_tree writes the truth beside the scene.
-    const auto truth = std::filesystem::path(scene_file).parent_path() / "truth.json";
-    if (std::filesystem::exists(truth))
-      truth_json = io::readTextFile(truth.string());
-  } else {
-    simulation::OrchardConfig orchard;
-    orchard.preset = preset;
-    simulation::Orchard generated = simulation::generateOrchard(orchard, o.seed);
-    scene = std::move(generated.scene);
-    truth_json = io::truthToJson(generated.truth);
-  }
+  const simulation::SceneAndTruth scene =
+      simulation::sceneFromFileOrPreset(scene_file, preset, o.seed);
   if (!output_dir_.empty()) {
     std::filesystem::create_directories(output_dir_);
-    simulation::saveScene(scene, output_dir_ + "/scene.json");
-    if (!truth_json.empty())
-      io::writeTextFile(output_dir_ + "/truth.json", truth_json);
+    simulation::saveScene(scene.scene, output_dir_ + "/scene.json");
+    if (scene.truth)
+      io::writeTextFile(output_dir_ + "/truth.json", io::truthToJson(*scene.truth));
   }
-  platform_ = std::make_unique<simulation::VirtualPlatform>(scene, o);
+  platform_ = std::make_unique<simulation::VirtualPlatform>(scene.scene, o);
 
   pose_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_pose", 1, true);
   move_srv_ = pnh.advertiseService("move_platform", &VirtualPlatformNode::movePlatform, this);
@@ -133,23 +121,24 @@ void VirtualPlatformNode::place(const Eigen::Isometry3d& pose, const Eigen::Isom
   pose_pub_.publish(msg);
   std::lock_guard<std::mutex> lock(mutex_);
   ++moves_;
-  nlohmann::json entry{{"true_pose", io::poseToJson(pose)}};
-  if (goal)
-    entry["goal_pose"] = io::poseToJson(*goal);
-  log_.push_back(entry.dump());
+  placements_.push_back({pose, goal ? std::optional<Eigen::Isometry3d>(*goal) : std::nullopt});
   writeLog();
 }
 
 void VirtualPlatformNode::writeLog() {
   if (output_dir_.empty())
     return;
-  std::string text = "{\n  \"frame\": \"" + scene_frame_ +
-                     "\",\n  \"pose\": \"platform frame in the scene\",\n  \"placements\": [";
-  for (std::size_t i = 0; i < log_.size(); ++i)
-    text += (i ? ",\n    " : "\n    ") + log_[i];
-  text += "\n  ]\n}\n";
+  nlohmann::json doc{{"frame", scene_frame_},
+                     {"pose", "platform frame in the scene"},
+                     {"placements", nlohmann::json::array()}};
+  for (const auto& p : placements_) {
+    nlohmann::json entry{{"true_pose", io::poseToJson(p.truth)}};
+    if (p.goal)
+      entry["goal_pose"] = io::poseToJson(*p.goal);
+    doc["placements"].push_back(entry);
+  }
   try {
-    io::writeTextFile(output_dir_ + "/platform.json", text);
+    io::writeTextFile(output_dir_ + "/platform.json", doc.dump(2) + "\n");
   } catch (const Error& e) {
     last_problem_ = e.what();
     ROS_ERROR_THROTTLE(10.0, "virtual_platform: %s", e.what());

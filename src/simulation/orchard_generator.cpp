@@ -1,9 +1,11 @@
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/io/tree_json.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {
@@ -62,13 +64,22 @@ Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed) {
   return orchard;
 }
 
-Scene sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
-                            std::uint64_t seed) {
-  if (!scene_path.empty())
-    return loadScene(scene_path);
-  OrchardConfig orchard;
-  orchard.preset = preset;
-  return generateOrchard(orchard, seed).scene;
+SceneAndTruth sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
+                                    std::uint64_t seed) {
+  SceneAndTruth out;
+  if (!scene_path.empty()) {
+    out.scene = loadScene(scene_path);
+    const auto truth = std::filesystem::path(scene_path).parent_path() / "truth.json";
+    if (std::filesystem::exists(truth))
+      out.truth = io::readTruthFile(truth.string());
+    return out;
+  }
+  OrchardConfig config;
+  config.preset = preset;
+  Orchard orchard = generateOrchard(config, seed);
+  out.scene = std::move(orchard.scene);
+  out.truth = std::move(orchard.truth);
+  return out;
 }
 
 }  // namespace simulation

@@ -74,7 +74,8 @@ int main(int argc, char** argv) {
       source = std::make_shared<lms111::RecordedScanSource>(
           lms111::RecordedScanSource::fromFile(telegram));
     } else {
-      const simulation::Scene scene = simulation::sceneFromFileOrPreset(scene_path, preset, seed);
+      const simulation::Scene scene =
+          simulation::sceneFromFileOrPreset(scene_path, preset, seed).scene;
       simulation::Lms111Config sensor;
       sensor.range_noise_sigma = noise_mm / 1000.0;
       const Eigen::Isometry3d pose = lms111::SimulatedScanSource::frontView(distance, height);

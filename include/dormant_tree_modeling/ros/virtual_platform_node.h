@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,7 @@ class VirtualPlatformNode {
   void goalCallback(const geometry_msgs::PoseStampedConstPtr& msg);
   /// Moves the platform, publishes and logs its pose; throws Error on a bad pose.
   void place(const Eigen::Isometry3d& pose, const Eigen::Isometry3d* goal);
-  void writeLog();
+  void writeLog();  // platform.json; under mutex_
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   std::unique_ptr<simulation::VirtualPlatform> platform_;
@@ -62,7 +63,11 @@ class VirtualPlatformNode {
   std::mutex mutex_;
   int goals_ = 0, moves_ = 0;
   std::string last_problem_;
-  std::vector<std::string> log_;  // JSON entries of platform.json
+  struct Placement {
+    Eigen::Isometry3d truth;
+    std::optional<Eigen::Isometry3d> goal;  // when it followed the acquisition's goal
+  };
+  std::vector<Placement> placements_;  // platform.json
 };
 
 }  // namespace ros_layer

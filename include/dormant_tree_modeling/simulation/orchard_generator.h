@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "dormant_tree_modeling/evaluation/ground_truth.h"
@@ -39,11 +40,18 @@ struct Orchard {
 /// @throws Error INVALID_ARGUMENT for an unknown preset or inconsistent spacing
 Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed);
 
-/// @brief The scene of a scene file (saveScene) when a path is given, else the default orchard
-/// of the preset and seed: what the emulators scan.
+/// @brief What the emulators scan, and the target's truth when it is known.
+struct SceneAndTruth {
+  Scene scene;
+  std::optional<evaluation::GroundTruth> truth;
+};
+
+/// @brief The scene of a scene file (saveScene) when a path is given, with the truth.json that
+/// synth_tree writes beside it if there is one; else the default orchard of the preset and
+/// seed, with its truth.
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR, INVALID_ARGUMENT
-Scene sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
-                            std::uint64_t seed);
+SceneAndTruth sceneFromFileOrPreset(const std::string& scene_path, const std::string& preset,
+                                    std::uint64_t seed);
 
 }  // namespace simulation
 }  // namespace dormant_tree_modeling
