@@ -66,7 +66,7 @@ std::optional<Circle> fitCircle(const Points2& pts) {
       break;
     c.center += step.head<2>();
     c.radius += step(2);
-    if (step.norm() < 1e-10)
+    if (step.norm() < 1e-8)
       break;
   }
   if (!(c.radius > 0.0) || !c.center.allFinite())

@@ -2,6 +2,7 @@
 #include "dormant_tree_modeling/common/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -91,30 +92,50 @@ double derivedSplitError(const std::vector<Cluster>& clusters, double configured
 
 std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clusters, double e_t,
                                    const ModelerConfig& config) {
+  // Splits run in waves: every cluster of a wave is split on its own core, and each split's
+  // k-means is seeded by the cluster itself (its first member and size), not by the order of
+  // work, so the result is the same however many threads run.
   std::vector<Cluster> done;
-  std::uint64_t stream = 0;
-  while (!clusters.empty()) {
-    Cluster c = std::move(clusters.back());
-    clusters.pop_back();
-    const bool small = static_cast<int>(c.members.size()) < 2 * config.min_cluster_points;
-    if (c.error <= e_t || small ||
-        static_cast<int>(done.size() + clusters.size()) >= MAX_CLUSTERS) {
-      done.push_back(std::move(c));
-      continue;
+  std::vector<Cluster> wave = std::move(clusters);
+  while (!wave.empty()) {
+    const int n = static_cast<int>(wave.size());
+    std::vector<char> split(n, 0);
+    int budget = MAX_CLUSTERS - static_cast<int>(done.size() + wave.size());
+    for (int c = 0; c < n; ++c) {
+      const bool small = static_cast<int>(wave[c].members.size()) < 2 * config.min_cluster_points;
+      if (wave[c].error > e_t && !small && budget > 0) {
+        split[c] = 1;
+        --budget;
+      }
     }
-    const auto labels =
-        kMeans(gather(pts, c.members), 2, config.kmeans_iterations, config.seed + 101 + stream++);
-    Cluster halves[2];
-    for (std::size_t i = 0; i < labels.size(); ++i)
-      halves[labels[i]].members.push_back(c.members[i]);
-    if (halves[1].members.empty()) {
-      done.push_back(std::move(c));
-      continue;
+    std::vector<std::array<Cluster, 2>> halves(n);
+    parallelFor(n, [&](int c) {
+      if (!split[c])
+        return;
+      const auto& members = wave[c].members;
+      const std::uint64_t seed = config.seed + 101 +
+                                 static_cast<std::uint64_t>(members.front()) * 1000003ULL +
+                                 members.size();
+      const auto labels = kMeans(gather(pts, members), 2, config.kmeans_iterations, seed);
+      for (std::size_t i = 0; i < labels.size(); ++i)
+        halves[c][labels[i]].members.push_back(members[i]);
+      if (halves[c][1].members.empty()) {
+        split[c] = 0;
+        return;
+      }
+      for (auto& h : halves[c])
+        updateCluster(pts, h);
+    });
+    std::vector<Cluster> next;
+    for (int c = 0; c < n; ++c) {
+      if (!split[c]) {
+        done.push_back(std::move(wave[c]));
+        continue;
+      }
+      for (auto& h : halves[c])
+        next.push_back(std::move(h));
     }
-    for (auto& h : halves) {
-      updateCluster(pts, h);
-      clusters.push_back(std::move(h));
-    }
+    wave.swap(next);
   }
   return done;
 }

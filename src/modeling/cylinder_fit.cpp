@@ -1,7 +1,9 @@
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <map>
 
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
@@ -10,6 +12,8 @@ namespace dormant_tree_modeling {
 namespace modeling {
 
 namespace {
+
+constexpr std::size_t PARALLEL_MIN_POINTS = 2000;  // below, one thread is faster
 
 void basis(const Eigen::Vector3d& a, Eigen::Vector3d& u, Eigen::Vector3d& v) {
   u = a.unitOrthogonal();
@@ -82,11 +86,17 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
   Eigen::Vector3d c = mean + circle->center.x() * u + circle->center.y() * v;
   double r = circle->radius;
   if (!fixed_axis) {
-    // Gauss-Newton on (centre shift in the plane, axis tilt, radius).
+    // Gauss-Newton on (centre shift in the plane, axis tilt, radius). On a cluster that is no
+    // cylinder (a fork, a junction) the steps oscillate: the fit stops at the lowest cost seen
+    // once a step fails to lower it.
+    double previous_cost = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d previous_c = c, previous_a = a;
+    double previous_r = r;
     for (int it = 0; it < 30; ++it) {
       basis(a, u, v);
       Eigen::Matrix<double, 5, 5> JtJ = Eigen::Matrix<double, 5, 5>::Zero();
       Eigen::Matrix<double, 5, 1> Jtr = Eigen::Matrix<double, 5, 1>::Zero();
+      double cost = 0.0;
       for (const auto& p : pts) {
         const Eigen::Vector3d w = p - c;
         const double t = w.dot(a);
@@ -98,9 +108,21 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
         // Derivatives of the distance: centre shift along u, v; axis tilt towards u, v; radius.
         Eigen::Matrix<double, 5, 1> J;
         J << -n.dot(u), -n.dot(v), -t * n.dot(u), -t * n.dot(v), -1.0;
-        JtJ += J * J.transpose();
+        JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J);
         Jtr += J * (d - r);
+        cost += (d - r) * (d - r);
       }
+      if (!(cost < previous_cost * (1.0 - 1e-9))) {
+        c = previous_c;
+        a = previous_a;
+        r = previous_r;
+        break;
+      }
+      previous_cost = cost;
+      previous_c = c;
+      previous_a = a;
+      previous_r = r;
+      JtJ = JtJ.selfadjointView<Eigen::Lower>();
       JtJ.diagonal() *= 1.0 + 1e-6;
       const Eigen::Matrix<double, 5, 1> step = JtJ.ldlt().solve(-Jtr);
       if (!step.allFinite())
@@ -108,7 +130,7 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
       c += step(0) * u + step(1) * v;
       a = (a + step(2) * u + step(3) * v).normalized();
       r += step(4);
-      if (step.norm() < 1e-10)
+      if (step.norm() < 1e-8)
         break;
     }
   }
@@ -148,20 +170,29 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
   co.iterations = o.circle_iterations;
   co.min_radius = o.min_radius;
   co.max_radius = o.max_radius;
+  // Each axis is tried independently (seeded by its index), on all cores; the best is
+  // chosen in axis order, so the answer does not depend on the threads.
+  std::vector<std::vector<int>> in(axes.size());
+  std::vector<char> found(axes.size(), 0);
+  parallelFor(
+      static_cast<int>(axes.size()),
+      [&](int k) {
+        Eigen::Vector3d ku, kv;
+        basis(axes[k], ku, kv);
+        Points2 plane;
+        plane.reserve(pts.size());
+        for (const auto& p : pts)
+          plane.emplace_back(p.dot(ku), p.dot(kv));
+        CircleRansacOptions ko = co;
+        ko.seed = o.seed * 1000003ULL + static_cast<std::uint64_t>(k);
+        found[k] = ransacCircle(plane, ko, &in[k]).has_value();
+      },
+      pts.size() < PARALLEL_MIN_POINTS ? 1 : 0);
   std::vector<int> best_in;
   Eigen::Vector3d best_axis = guess;
   for (std::size_t k = 0; k < axes.size(); ++k) {
-    basis(axes[k], u, v);
-    Points2 plane;
-    plane.reserve(pts.size());
-    for (const auto& p : pts)
-      plane.emplace_back(p.dot(u), p.dot(v));
-    co.seed = o.seed * 1000003ULL + k;
-    std::vector<int> in;
-    if (!ransacCircle(plane, co, &in))
-      continue;
-    if (in.size() > best_in.size()) {
-      best_in = in;
+    if (found[k] && in[k].size() > best_in.size()) {
+      best_in = std::move(in[k]);
       best_axis = axes[k];
     }
   }

@@ -22,6 +22,7 @@ constexpr double WIRE_LINEARITY = 0.1;       // second / first eigenvalue below 
 constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr int MAX_WIRES = 10;
+constexpr double WIRE_TEST_VOXEL = 0.01;  // m
 
 /// Removes points near a near-horizontal plane at the bottom of the cloud, if it is large.
 std::size_t removeGround(Points& pts, std::uint64_t seed) {
@@ -99,8 +100,10 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   if (pts.size() < 100)
     return 0;
   // Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
-  // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points.
-  const PointIndex index(pts);
+  // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points,
+  // against a 1 cm grid of the cloud: the shape of a 10 cm ball needs no finer sampling.
+  const Points coarse = voxelDownsample(pts, WIRE_TEST_VOXEL);
+  const PointIndex index(coarse);
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);
   const int samples = static_cast<int>((pts.size() + stride - 1) / stride);
   std::vector<char> linear(samples, 0);
@@ -111,7 +114,7 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
       return;
     Points local;
     for (const int j : nn)
-      local.push_back(pts[j]);
+      local.push_back(coarse[j]);
     Eigen::Vector3d eig;
     const Eigen::Vector3d dir = principalAxis(local, nullptr, &eig);
     linear[k] = eig(1) < WIRE_LINEARITY * eig(2) && std::abs(dir.z()) < std::sin(WIRE_MAX_TILT);
@@ -205,7 +208,12 @@ std::vector<std::pair<CellKey, int>> sortedByCell(const Points& pts, double cell
 double medianSpacing(const Points& pts) {
   if (pts.size() < 2)
     return 0.0;
-  const PointIndex index(pts);
+  return medianSpacing(pts, PointIndex(pts));
+}
+
+double medianSpacing(const Points& pts, const PointIndex& index) {
+  if (pts.size() < 2)
+    return 0.0;
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 2000);
   std::vector<double> d;
   for (std::size_t i = 0; i < pts.size(); i += stride) {

@@ -7,9 +7,11 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
@@ -24,6 +26,8 @@ namespace {
 constexpr std::size_t MIN_POINTS = 100;
 constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
 constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
+constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
+constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
 
 class Stopwatch {
  public:
@@ -59,13 +63,34 @@ double noiseGuess(const Points& pts, const Cluster& cluster) {
   return noiseFromRadialResiduals(std::move(res));
 }
 
+/// Horizontal offsets of track b from track a at a's centres up to `below` (m), where b spans
+/// their height.
+std::vector<double> trackOffsets(const TrackedTrunk& a, const TrackedTrunk& b,
+                                 double below = std::numeric_limits<double>::infinity()) {
+  std::vector<double> out;
+  for (const auto& p : a.centers) {
+    if (p.z() > below)
+      break;
+    for (std::size_t i = 0; i + 1 < b.centers.size(); ++i) {
+      const Eigen::Vector3d &lo = b.centers[i], &hi = b.centers[i + 1];
+      if (p.z() < lo.z() || p.z() > hi.z() || hi.z() - lo.z() < 1e-9)
+        continue;
+      const double t = (p.z() - lo.z()) / (hi.z() - lo.z());
+      out.push_back((p.head<2>() - (lo + t * (hi - lo)).head<2>()).norm());
+      break;
+    }
+  }
+  return out;
+}
+
 /// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder
 /// piece near the bottom, Algorithm 2's start among them) and keep the track with the most
 /// points around it between 5 and 35 cm from its axis: branches. A post has none, a
 /// neighbour's branch is no vertical cylinder.
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
                                            const std::vector<Cluster>& clusters,
-                                           const TrunkPath& path, const ModelerConfig& config) {
+                                           const TrunkPath& path, const ModelerConfig& config,
+                                           std::vector<TrunkCandidate>* report) {
   double zmin = std::numeric_limits<double>::infinity();
   for (const auto& c : clusters)
     zmin = std::min(zmin, c.centroid.z());
@@ -87,44 +112,130 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     hi = hi.cwiseMax(p.head<2>());
   }
   const Eigen::Vector2d middle = 0.5 * (lo + hi);
-  std::optional<TrackedTrunk> best;
-  double best_score = -1.0;
+  // The circle band is the scanner's noise, one value for all candidates: the median of their
+  // fits' noise guesses (a fragment's own guess can be twice the noise, and a band that thick
+  // lets a small circle on the trunk's flank outscore the trunk's own).
+  std::vector<double> guesses;
   for (const int c : candidates) {
+    if (clusters[c].fit)
+      guesses.push_back(noiseGuess(pts, clusters[c]));
+  }
+  const double threshold = std::max(0.5 * config.circle_threshold, 2.5 * median(guesses));
+  // Candidates are tracked independently, on all cores; the best is chosen in candidate order.
+  std::vector<std::optional<TrackedTrunk>> tracks(candidates.size());
+  std::vector<double> scores(candidates.size(), -1.0);
+  parallelFor(static_cast<int>(candidates.size()), [&](int k) {
+    const int c = candidates[k];
     if (!clusters[c].fit)
-      continue;
+      return;
     const Cylinder& first = *clusters[c].fit;
-    const Eigen::Vector3d up = first.axis.z() < 0.0 ? Eigen::Vector3d(-first.axis) : first.axis;
-    const Eigen::Vector3d start = first.center - 0.5 * first.length * up;
-    const double threshold =
-        std::max(0.5 * config.circle_threshold, 2.5 * noiseGuess(pts, clusters[c]));
+    const Eigen::Vector3d axis = first.axis.z() < 0.0 ? Eigen::Vector3d(-first.axis) : first.axis;
+    const Eigen::Vector3d start = first.center - 0.5 * first.length * axis;
+    // Tracking starts upright: a fragment's fitted axis can lean by tens of degrees, and an
+    // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
     TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
     if (tracked.centers.size() < 3)
-      continue;
+      return;
     // And down to the ground: where the first cluster begins is an accident of k-means.
     const TrackedTrunk down = trackTrunk(pts, index, tracked.centers.front(), -up,
                                          tracked.radii.front(), threshold, config);
     tracked.centers.insert(tracked.centers.begin(), down.centers.rbegin(), down.centers.rend());
     tracked.radii.insert(tracked.radii.begin(), down.radii.rbegin(), down.radii.rend());
     double shell = 0.0;
-    for (std::size_t k = 0; k < tracked.centers.size(); k += 2) {
-      const double r = tracked.radii[k];
-      shell += index.countWithin(tracked.centers[k], r + 0.35, 1 << 20) -
-               index.countWithin(tracked.centers[k], r + 0.05, 1 << 20);
+    for (std::size_t k2 = 0; k2 < tracked.centers.size(); k2 += 2) {
+      const double r = tracked.radii[k2];
+      shell += index.countWithin(tracked.centers[k2], r + 0.35, 1 << 20) -
+               index.countWithin(tracked.centers[k2], r + 0.05, 1 << 20);
     }
     const double off_centre = (start.head<2>() - middle).norm() / CENTRE_PRIOR_SCALE;
     // A trunk stands on the ground: a track whose lowest slice floats above the cloud's
     // bottom is a branch or the leader's top half, whatever the branches around it.
     double lowest = 1e300;
-    for (const auto& c : tracked.centers)
-      lowest = std::min(lowest, c.z());
+    for (const auto& p : tracked.centers)
+      lowest = std::min(lowest, p.z());
     const double floating = std::max(0.0, lowest - (zmin + GROUND_REACH)) / GROUND_REACH;
-    const double score =
-        shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
-    if (score > best_score) {
-      best_score = score;
-      best = std::move(tracked);
+    scores[k] = shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
+    tracks[k] = std::move(tracked);
+  });
+  // Tracks from bases on one trunk follow one axis, except where one strays into a branch
+  // (and scores high among the branches). Tracks that stand on one base (median offset over
+  // their lowest BASE_HEIGHT below a radius) are one trunk; a trunk scores the median of its
+  // tracks, and is represented by the track that strays least from the others.
+  const int m = static_cast<int>(candidates.size());
+  std::vector<std::vector<double>> mean_offset(m, std::vector<double>(m, 0.0));
+  std::vector<int> group(m, -1);
+  for (int a = 0; a < m; ++a) {
+    if (!tracks[a])
+      continue;
+    if (group[a] < 0)
+      group[a] = a;
+    for (int b = a + 1; b < m; ++b) {
+      if (!tracks[b])
+        continue;
+      const auto offsets = trackOffsets(*tracks[a], *tracks[b]);
+      mean_offset[a][b] = mean_offset[b][a] =
+          offsets.size() < 4
+              ? std::numeric_limits<double>::infinity()
+              : std::accumulate(offsets.begin(), offsets.end(), 0.0) / offsets.size();
+      const auto base =
+          trackOffsets(*tracks[a], *tracks[b], tracks[a]->centers.front().z() + BASE_HEIGHT);
+      const double same =
+          std::max(SAME_TRUNK_MIN, std::min(median(tracks[a]->radii), median(tracks[b]->radii)));
+      if (group[b] < 0 && base.size() >= 3 && median(base) < same)
+        group[b] = group[a];
     }
   }
+  int chosen = -1;
+  double best_score = -1.0;
+  for (int g = 0; g < m; ++g) {
+    std::vector<double> member_scores;
+    for (int k = 0; k < m; ++k) {
+      if (group[k] == g)
+        member_scores.push_back(scores[k]);
+    }
+    if (member_scores.empty())
+      continue;
+    const double score = median(member_scores);
+    if (score <= best_score)
+      continue;
+    best_score = score;
+    double least = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < m; ++k) {
+      if (group[k] != g)
+        continue;
+      double stray = 0.0;
+      for (int o = 0; o < m; ++o) {
+        if (o != k && group[o] == g)
+          stray += std::min(mean_offset[k][o], 1.0);
+      }
+      if (stray < least) {
+        least = stray;
+        chosen = k;
+      }
+    }
+  }
+  report->assign(candidates.size(), TrunkCandidate{});
+  for (int k = 0; k < m; ++k) {
+    TrunkCandidate& r = (*report)[k];
+    if (const auto& fit = clusters[candidates[k]].fit) {
+      r.start = fit->center;
+      r.start_radius = fit->radius;
+    }
+    if (!tracks[k])
+      continue;
+    r.slices = static_cast<int>(tracks[k]->centers.size());
+    r.bottom = tracks[k]->centers.front().z();
+    r.top = tracks[k]->centers.back().z();
+    r.median_radius = median(tracks[k]->radii);
+    r.score = scores[k];
+    r.group = group[k];
+  }
+  std::optional<TrackedTrunk> best;
+  if (chosen >= 0)
+    best = std::move(tracks[chosen]);
+  if (chosen >= 0)
+    (*report)[chosen].chosen = true;
   return best;
 }
 
@@ -170,8 +281,12 @@ ModelResult TreeModeler::model(const Points& input) const {
                 "only " + std::to_string(pts.size()) + " points left after preprocessing");
   }
 
+  // One index of the modeled cloud for the spacing, the graph, the trunk tracking and the
+  // branch step.
+  const PointIndex index(pts);
+  watch.lap("index");
   // Algorithm 2.
-  auto clusters = initialClusters(pts, config_, medianSpacing(pts));
+  auto clusters = initialClusters(pts, config_, medianSpacing(pts, index));
 
   watch.lap("kmeans");
   result.split_error = config_.ours_derive_parameters
@@ -180,8 +295,6 @@ ModelResult TreeModeler::model(const Points& input) const {
   clusters = splitClusters(pts, std::move(clusters), result.split_error, config_);
   clusters = mergeClusters(pts, std::move(clusters), config_.merge_distance);
   watch.lap("split_merge");
-  // One index of the modeled cloud for the graph, the trunk tracking and the branch step.
-  const PointIndex index(pts);
   const auto adjacency = connectClusters(pts, index, clusters, config_);
   const TrunkPath path = findTrunkPath(clusters, adjacency, config_);
   watch.lap("graph");
@@ -214,18 +327,23 @@ ModelResult TreeModeler::model(const Points& input) const {
   std::sort(radii.begin(), radii.end());
   double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
   if (config_.ours_follow_diameter) {
-    if (const auto tracked = trackBestTrunk(pts, index, clusters, path, config_)) {
+    if (const auto tracked =
+            trackBestTrunk(pts, index, clusters, path, config_, &result.trunk_candidates)) {
       axis = tracked->centers;
       radius = median(tracked->radii);
       // The trunk region becomes every point near the tracked axis, not only the clusters
       // Algorithm 2 linked.
       const Centerline line(axis);
       const double reach = std::max(3.0 * radius, radius + 0.05);
-      region.clear();
-      for (std::size_t i = 0; i < pts.size(); ++i) {
+      std::vector<char> near(pts.size(), 0);
+      parallelFor(static_cast<int>(pts.size()), [&](int i) {
         double d = 0.0;
         const double s = line.project(pts[i], &d);
-        if (d <= reach && s >= -0.05 && s <= line.length() + 0.05)
+        near[i] = d <= reach && s >= -0.05 && s <= line.length() + 0.05;
+      });
+      region.clear();
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (near[i])
           region.push_back(static_cast<int>(i));
       }
     }

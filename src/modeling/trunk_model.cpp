@@ -22,6 +22,7 @@ constexpr double ZERO_SLOPE = 0.05;  // |d eta_share| below this is a flat eta
 constexpr int MIN_SLICE_POINTS = 12;
 constexpr double MIN_TRUNK_RADIUS = 0.003;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
+constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
 constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
 
 struct Projected {
@@ -356,7 +357,9 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     const double sigma = threshold / 2.5;
     if (plane.size() < MIN_SLICE_POINTS) {
       // nothing to fit
-    } else if (sigma < 0.2 * r) {
+    } else if (first || sigma < 0.2 * r) {
+      // The first circle is RANSAC's whatever the guess: the disc below needs the radius, and
+      // a small guess (a fragment's arc fit) would settle on a patch of the trunk's flank.
       circle = ransacCircle(plane, o, &inliers);
     } else {
       // Noise comparable to the radius: a circle band would cover the whole disc. The disc's
@@ -400,7 +403,9 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
       if (step_dir.allFinite() && step_dir.dot(t) > 0.5)
         t = (0.7 * t + 0.3 * step_dir).normalized();
     }
-    r = 0.7 * r + 0.3 * circle->radius;
+    // The first circle was searched with any trunk radius: it replaces the start's guess
+    // (blending a cluster's arc-fit radius in would cap the next circles below the trunk's).
+    r = first ? circle->radius : 0.7 * r + 0.3 * circle->radius;
     c = centre;
     out.centers.push_back(centre);
     out.radii.push_back(circle->radius);
@@ -459,8 +464,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   Centerline line(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   std::vector<double> s(region.size()), dist(region.size());
   auto projectAll = [&] {
-    for (std::size_t k = 0; k < region.size(); ++k)
-      s[k] = line.project(pts[region[k]], &dist[k]);
+    parallelFor(static_cast<int>(region.size()),
+                [&](int k) { s[k] = line.project(pts[region[k]], &dist[k]); });
   };
   projectAll();
   // Slice circles stay near the radius of the trunk clusters (a circle through branch points
@@ -580,6 +585,15 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
+  if (config.ours_constrain_ransac) {
+    // A trunk tapers: a segment measured thicker than the one below it by more than a swelling
+    // at a whorl has circles through branch bases or noise wider than its radius (the thin
+    // top at high noise); the segment below bounds it.
+    for (std::size_t i = 1; i < trunk.cylinders.size(); ++i) {
+      const double below = trunk.cylinders[i - 1].radius;
+      trunk.cylinders[i].radius = std::min(trunk.cylinders[i].radius, below * (1.0 + TAPER_SWELL));
+    }
+  }
   return trunk;
 }
 

@@ -185,6 +185,51 @@ TEST(TrunkModel, TaperedTrunkWithBranchesGivesSegmentsAndRadii) {
   EXPECT_GT(share_at_branch, share_clear + 0.05);
 }
 
+TEST(TrunkTracking, AStartOnTheFlankWithASmallGuessFindsTheWholeTrunk) {
+  // A thick trunk (r 8 cm) with 7 mm radial noise, tracked from a point on its flank with the
+  // radius of a fragment's arc fit (2.5 cm): the first circle must be the trunk's, not a patch
+  // of its surface the size of the guess.
+  Points pts;
+  Rng rng(5);
+  for (int i = 0; i < 20000; ++i) {
+    const double z = rng.uniform(0.0, 1.0), phi = rng.uniform(0.0, 2.0 * M_PI);
+    const double r = 0.08 + rng.normal(0.0, 0.007);
+    pts.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  const PointIndex index(pts);
+  ModelerConfig config;
+  const TrackedTrunk track =
+      trackTrunk(pts, index, {0.07, 0.03, 0.1}, {0, 0, 1}, 0.025, 2.5 * 0.007, config);
+  ASSERT_GE(track.centers.size(), 10u);
+  for (std::size_t k = 0; k < track.centers.size(); ++k) {
+    EXPECT_LT(track.centers[k].head<2>().norm(), 0.015) << "slice " << k;
+    EXPECT_NEAR(track.radii[k], 0.08, 0.015) << "slice " << k;
+  }
+}
+
+TEST(TrunkModel, ASegmentThickerThanTheOneBelowIsBoundedByIt) {
+  // The top part's points are a wide cloud (noise wider than its radius, branch bases):
+  // measured alone it would come out thicker than the trunk below.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 0.6);
+  addCylinder(pts, {0, 0, 0.6}, {0, 0, 1}, 0.05, 0.6);
+  std::vector<int> region(pts.size());
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.0;
+  config.beam_spread = 0.0;
+  config.radius_continuity = 1.0;  // let the slices follow the jump
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.04, config);
+  ASSERT_GE(trunk.cylinders.size(), 2u);
+  for (std::size_t i = 1; i < trunk.cylinders.size(); ++i) {
+    EXPECT_LE(trunk.cylinders[i].radius, 1.1 * trunk.cylinders[i - 1].radius + 1e-12)
+        << "segment " << i;
+  }
+  config.ours_constrain_ransac = false;
+  const TrunkModel free = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.04, config);
+  EXPECT_GT(free.cylinders.back().radius, 0.045);
+}
+
 TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   Points pts;
   addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);  // trunk

@@ -16,8 +16,13 @@ struct PreprocessStats {
   double floating_radius = 0.0;  ///< neighbourhood radius used for floating pixels (m)
 };
 
+class PointIndex;
+
 /// @brief Median distance from a point to its nearest neighbour (on a sample of the points).
 double medianSpacing(const Points& pts);
+
+/// @brief medianSpacing with an index of pts that already exists.
+double medianSpacing(const Points& pts, const PointIndex& index);
 
 /// @brief Voxel-grid downsampling: the centroid of the points in each occupied voxel, in a
 /// deterministic order (sorted by voxel key).

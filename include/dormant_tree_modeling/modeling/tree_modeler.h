@@ -17,6 +17,18 @@ namespace modeling {
 /// @brief Per-point class of the modeled (downsampled, cleaned) cloud.
 enum class PointClass : std::uint8_t { OTHER = 0, TRUNK = 1, PRIMARY = 2 };
 
+/// @brief One trunk base the modeler tracked (ours, ours_follow_diameter), for diagnostics.
+struct TrunkCandidate {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();  ///< where tracking began
+  double start_radius = 0.0;                        ///< the start cluster's fitted radius (m)
+  int slices = 0;                  ///< circles along the track (0: it did not take)
+  double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
+  double median_radius = 0.0;      ///< of the track's circles (m)
+  double score = -1.0;             ///< branch points around it, weighted
+  int group = -1;                  ///< candidates whose tracks follow one trunk share a group
+  bool chosen = false;             ///< the track that became the trunk's axis
+};
+
 /// @brief Everything one modeling run produced.
 struct ModelResult {
   TreeModel model;
@@ -30,6 +42,7 @@ struct ModelResult {
   int primary_clusters = 0;
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
   std::vector<RejectedBranch> rejected_branches;        ///< candidates turned down, and why
+  std::vector<TrunkCandidate> trunk_candidates;         ///< trunk bases tracked
 };
 
 /// @brief Algorithms 2 and 3 of the paper (docs/algorithms.md), plus the switchable additions of
