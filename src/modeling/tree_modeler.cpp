@@ -27,6 +27,7 @@ constexpr std::size_t MIN_POINTS = 100;
 constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
 constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
+constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
 
 class Stopwatch {
@@ -200,17 +201,27 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     if (score <= best_score)
       continue;
     best_score = score;
+    // Among tracks that stray alike (within STRAY_TIE per other track; two tracks always
+    // stray alike), the one reaching highest: a track can stop early at a whorl.
+    std::vector<double> stray(m, std::numeric_limits<double>::infinity());
     double least = std::numeric_limits<double>::infinity();
+    int others = -1;
     for (int k = 0; k < m; ++k) {
       if (group[k] != g)
         continue;
-      double stray = 0.0;
+      ++others;
+      stray[k] = 0.0;
       for (int o = 0; o < m; ++o) {
         if (o != k && group[o] == g)
-          stray += std::min(mean_offset[k][o], 1.0);
+          stray[k] += std::min(mean_offset[k][o], 1.0);
       }
-      if (stray < least) {
-        least = stray;
+      least = std::min(least, stray[k]);
+    }
+    double highest = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < m; ++k) {
+      if (group[k] == g && stray[k] <= least + STRAY_TIE * others &&
+          tracks[k]->centers.back().z() > highest) {
+        highest = tracks[k]->centers.back().z();
         chosen = k;
       }
     }
