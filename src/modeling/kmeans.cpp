@@ -9,10 +9,6 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
-namespace {
-constexpr int PARALLEL_MIN_POINTS = 20000;  // below, starting threads costs more than it saves
-}  // namespace
-
 std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint64_t seed) {
   const int n = static_cast<int>(pts.size());
   std::vector<int> labels(n, 0);
@@ -79,25 +75,22 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
       }
       half_gap[c] = 0.5 * nearest;
     }
-    // Assignment: independent per point, so it runs on every core with identical results
-    // (small inputs, such as a cluster being split on one core of many, stay on their thread).
-    parallelFor(
-        n,
-        [&](int i) {
-          moved[i] = 0;
-          if (it == 0) {
-            scan(i);
-            return;
-          }
-          const double bound = std::max(half_gap[labels[i]], lower[i]);
-          if (upper[i] <= bound)
-            return;
-          upper[i] = (pts[i] - centres[labels[i]]).norm();
-          if (upper[i] <= bound)
-            return;
-          scan(i);
-        },
-        n < PARALLEL_MIN_POINTS ? 1 : 0);
+    // Assignment: independent per point, so it runs on every core with identical results (a
+    // cluster's k-means inside splitClusters' parallel loop runs on its own thread).
+    parallelFor(n, [&](int i) {
+      moved[i] = 0;
+      if (it == 0) {
+        scan(i);
+        return;
+      }
+      const double bound = std::max(half_gap[labels[i]], lower[i]);
+      if (upper[i] <= bound)
+        return;
+      upper[i] = (pts[i] - centres[labels[i]]).norm();
+      if (upper[i] <= bound)
+        return;
+      scan(i);
+    });
     const bool changed = std::find(moved.begin(), moved.end(), 1) != moved.end();
     std::fill(sums.begin(), sums.end(), Eigen::Vector3d::Zero());
     std::fill(counts.begin(), counts.end(), 0);

@@ -85,9 +85,9 @@ std::vector<double> trackOffsets(const TrackedTrunk& a, const TrackedTrunk& b,
 }
 
 /// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder
-/// piece near the bottom, Algorithm 2's start among them) and keep the track with the most
-/// points around it between 5 and 35 cm from its axis: branches. A post has none, a
-/// neighbour's branch is no vertical cylinder.
+/// piece near the bottom, Algorithm 2's start among them), group the tracks that stand on one
+/// base, and keep the trunk whose tracks have the most points around them between 5 and 35 cm
+/// from their axis: branches. A post has none, a neighbour's branch is no vertical cylinder.
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
                                            const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config,
@@ -242,12 +242,10 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     r.score = scores[k];
     r.group = group[k];
   }
-  std::optional<TrackedTrunk> best;
-  if (chosen >= 0)
-    best = std::move(tracks[chosen]);
-  if (chosen >= 0)
-    (*report)[chosen].chosen = true;
-  return best;
+  if (chosen < 0)
+    return std::nullopt;
+  (*report)[chosen].chosen = true;
+  return std::move(tracks[chosen]);
 }
 
 }  // namespace

@@ -25,10 +25,6 @@ constexpr double MAX_TRUNK_RADIUS = 0.4;
 constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
 constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
 
-struct Projected {
-  std::vector<double> s;  // arc length of each region point
-};
-
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
   double min_radius = MIN_TRUNK_RADIUS;
