@@ -9,6 +9,10 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
+namespace {
+constexpr int BLOCK = 4096;  // points per task of the parallel loops
+}  // namespace
+
 std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint64_t seed) {
   const int n = static_cast<int>(pts.size());
   std::vector<int> labels(n, 0);
@@ -16,15 +20,40 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
   if (n == 0 || k == 1)
     return labels;
   Rng rng(seed);
-  // k-means++ seeding: each next centre drawn with probability proportional to D^2.
+  // k-means++ seeding: each next centre drawn with probability proportional to D^2. Each
+  // point's nearest and second-nearest centre are kept as the centres arrive: that is the
+  // first assignment of Lloyd's iterations, exactly, without scanning all k centres again.
   std::vector<Eigen::Vector3d> centres{pts[rng.uniformInt(0, n - 1)]};
   std::vector<double> d2(n, std::numeric_limits<double>::infinity());
+  std::vector<double> second_d2(n, std::numeric_limits<double>::infinity());
+  // Points go to the threads in blocks: a call per point would cost as much as its work.
+  const int blocks = (n + BLOCK - 1) / BLOCK;
+  const auto forEachPoint = [&](const auto& fn) {
+    parallelFor(blocks, [&](int b) {
+      const int end = std::min(n, (b + 1) * BLOCK);
+      for (int i = b * BLOCK; i < end; ++i)
+        fn(i);
+    });
+  };
+  auto admit = [&](int c) {
+    // Same order and strict comparisons as a scan over the centres in index order.
+    const Eigen::Vector3d centre = centres[c];
+    forEachPoint([&](int i) {
+      const double d = (pts[i] - centre).squaredNorm();
+      if (d < d2[i]) {
+        second_d2[i] = d2[i];
+        d2[i] = d;
+        labels[i] = c;
+      } else if (d < second_d2[i]) {
+        second_d2[i] = d;
+      }
+    });
+  };
+  admit(0);
   while (static_cast<int>(centres.size()) < k) {
     double total = 0.0;
-    for (int i = 0; i < n; ++i) {
-      d2[i] = std::min(d2[i], (pts[i] - centres.back()).squaredNorm());
+    for (int i = 0; i < n; ++i)
       total += d2[i];
-    }
     if (total <= 0.0)
       break;  // fewer distinct points than k
     double pick = rng.uniform() * total;
@@ -37,6 +66,7 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
       }
     }
     centres.push_back(pts[chosen]);
+    admit(static_cast<int>(centres.size()) - 1);
   }
   k = static_cast<int>(centres.size());
   std::vector<Eigen::Vector3d> sums(k);
@@ -77,10 +107,13 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
     }
     // Assignment: independent per point, so it runs on every core with identical results (a
     // cluster's k-means inside splitClusters' parallel loop runs on its own thread).
-    parallelFor(n, [&](int i) {
+    forEachPoint([&](int i) {
       moved[i] = 0;
       if (it == 0) {
-        scan(i);
+        // Assigned while seeding; labels start at 0, as the scan's comparison assumes.
+        moved[i] = labels[i] != 0;
+        upper[i] = std::sqrt(d2[i]);
+        lower[i] = std::sqrt(second_d2[i]);
         return;
       }
       const double bound = std::max(half_gap[labels[i]], lower[i]);

@@ -150,6 +150,37 @@ TEST(KMeans, DeterministicAndSeparatesBlobs) {
     EXPECT_EQ(l, 0);
 }
 
+TEST(KMeans, ConvergedLabelsAreTheNearestCentres) {
+  // Many clusters along a branch-like line: most points lie near two or more centres, so the
+  // bounds that skip the scan, and the assignment made while seeding, are all exercised.
+  Rng rng(21);
+  Points pts;
+  for (int i = 0; i < 6000; ++i)
+    pts.emplace_back(rng.uniform() * 3.0, rng.normal(0, 0.03), rng.normal(0, 0.03));
+  const int k = 60;
+  const auto labels = kMeans(pts, k, 300, 5);
+  std::vector<Eigen::Vector3d> centres(k, Eigen::Vector3d::Zero());
+  std::vector<int> counts(k, 0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    ASSERT_GE(labels[i], 0);
+    ASSERT_LT(labels[i], k);
+    centres[labels[i]] += pts[i];
+    ++counts[labels[i]];
+  }
+  for (int c = 0; c < k; ++c) {
+    ASSERT_GT(counts[c], 0);
+    centres[c] /= counts[c];
+  }
+  // At convergence every point is (one of) the nearest to its own cluster's mean.
+  int wrong = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const double own = (pts[i] - centres[labels[i]]).squaredNorm();
+    for (int c = 0; c < k; ++c)
+      wrong += (pts[i] - centres[c]).squaredNorm() < own - 1e-12 ? 1 : 0;
+  }
+  EXPECT_EQ(wrong, 0);
+}
+
 }  // namespace
 }  // namespace modeling
 }  // namespace dormant_tree_modeling
