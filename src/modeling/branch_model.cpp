@@ -14,7 +14,6 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
-constexpr int MAX_EXTRACTIONS = 400;  // re-clustered remainders per tree, a bound on the work
 
 /// Where a point sits relative to the trunk model.
 struct TrunkCoords {
@@ -166,7 +165,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     // A candidate that fits no branch may be several branches fused into one cluster (close
     // neighbours, a shoot bridging two): split in two by position and look at each half.
     auto reject = [&](const char* reason, bool splittable) {
-      if (splittable && config.ours_constrain_ransac && extractions < MAX_EXTRACTIONS &&
+      if (splittable && config.ours_constrain_ransac && extractions < config.branch_search_budget &&
           static_cast<int>(cluster.size()) >= 4 * config.branch_min_points) {
         Points cluster_pts;
         for (const int k : cluster)
@@ -190,6 +189,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       r.centroid /= static_cast<double>(cluster.size());
       r.points = static_cast<int>(cluster.size());
       r.reason = reason;
+      if (splittable && config.ours_constrain_ransac && extractions >= config.branch_search_budget)
+        r.reason += " (search budget spent)";
       rejected->push_back(r);
     };
     if (static_cast<int>(sub.size()) < config.branch_min_points) {
@@ -301,7 +302,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     fit.trunk_segment = segment;
     fit.attachment = attachment;
     branches.push_back(std::move(fit));
-    if (config.ours_constrain_ransac && extractions < MAX_EXTRACTIONS) {
+    if (config.ours_constrain_ransac) {
       // Take this branch's points out and look again at what remains of the cluster.
       const double reach = cyl->radius + 2.5 * std::max(sigma, scatter) + 0.005;
       Points rest_pts;
@@ -313,13 +314,24 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         }
       }
       if (static_cast<int>(rest.size()) >= 2 * config.branch_min_points) {
-        for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
-                                                  config.branch_min_points)) {
-          std::vector<int> mapped;
-          for (const int k : part)
-            mapped.push_back(rest[k]);
-          work.push_back(std::move(mapped));
-          ++extractions;
+        if (extractions < config.branch_search_budget) {
+          for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
+                                                    config.branch_min_points)) {
+            std::vector<int> mapped;
+            for (const int k : part)
+              mapped.push_back(rest[k]);
+            work.push_back(std::move(mapped));
+            ++extractions;
+          }
+        } else if (rejected) {
+          // Said, not silently dropped: what may hold another branch was not looked at.
+          RejectedBranch r;
+          for (const Eigen::Vector3d& p : rest_pts)
+            r.centroid += p;
+          r.centroid /= static_cast<double>(rest_pts.size());
+          r.points = static_cast<int>(rest.size());
+          r.reason = "remainder not searched (search budget spent)";
+          rejected->push_back(r);
         }
       }
     }

@@ -258,6 +258,34 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_EQ(reasons["too low"], 1);
 }
 
+TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
+  // Two primaries leave from one point 30 deg apart: near the trunk they are one cluster, so
+  // the second is found only in what is left after the first is taken out.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
+  const std::size_t trunk_points = pts.size();
+  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.27, 0.1}, 0.01, 0.5);
+  addCylinder(pts, {0.03, 0, 0.8}, {1, -0.27, 0.1}, 0.01, 0.5);
+  std::vector<int> region(trunk_points);
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.002;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  const PointIndex index(pts);
+  std::vector<RejectedBranch> rejected;
+  EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 2u);
+  for (const auto& r : rejected)
+    EXPECT_EQ(r.reason.find("budget"), std::string::npos) << r.reason;
+
+  config.branch_search_budget = 0;
+  rejected.clear();
+  EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 1u);
+  int unsearched = 0;
+  for (const auto& r : rejected)
+    unsearched += r.reason.find("(search budget spent)") != std::string::npos;
+  EXPECT_EQ(unsearched, 1) << "the lost branch is reported";
+}
+
 TEST(TrunkModel, TooLittleIsNoTrunk) {
   ModelerConfig config;
   try {

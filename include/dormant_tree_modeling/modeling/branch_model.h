@@ -25,7 +25,8 @@ struct RejectedBranch {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the candidate's points
   int points = 0;
   std::string reason;  ///< "too few points", "no fit", "not radial", "misses the trunk",
-                       ///< "not at the surface", "too short", "too low", "duplicate"
+                       ///< "not at the surface", "too short", "too low", "duplicate"; with
+                       ///< " (search budget spent)" when it was not split for lack of budget
 };
 
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`

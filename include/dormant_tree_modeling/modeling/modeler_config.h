@@ -75,6 +75,11 @@ struct ModelerConfig {
   double trunk_max_tilt = 30.0;  ///< trunk cylinders' axes within this of vertical
   double radius_continuity =
       0.35;  ///< a trunk segment's radius within this share of its neighbour's
+  /// Re-clusterings of what is left after a branch is taken out of a candidate cluster, and
+  /// halvings of candidates that fit no branch, per tree: a bound on the work. A real tree
+  /// needs hundreds (a mature tree lost a third of its branches at 400); candidates left
+  /// unsplit are reported with "(search budget spent)"
+  int branch_search_budget = 4000;
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
   /// Branch axis seen along the trunk (elevation removed) vs the direction away from it, deg.
   double branch_max_azimuth = 20.0;
