@@ -29,6 +29,7 @@ constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trun
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
+constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
 
 class Stopwatch {
  public:
@@ -190,9 +191,17 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   int chosen = -1;
   double best_score = -1.0;
   for (int g = 0; g < m; ++g) {
-    std::vector<double> member_scores;
+    // Only the tracks that climb most of the group's height vote: a track that stopped at a
+    // whorl low on the trunk has a small shell and would drag its trunk below a neighbour's.
+    double group_top = -std::numeric_limits<double>::infinity();
     for (int k = 0; k < m; ++k) {
       if (group[k] == g)
+        group_top = std::max(group_top, tracks[k]->centers.back().z());
+    }
+    std::vector<double> member_scores;
+    for (int k = 0; k < m; ++k) {
+      if (group[k] == g &&
+          tracks[k]->centers.back().z() - zmin >= VOTING_HEIGHT * (group_top - zmin))
         member_scores.push_back(scores[k]);
     }
     if (member_scores.empty())
