@@ -8,6 +8,8 @@ namespace modeling {
 
 namespace {
 
+constexpr double MAX_NOISE_EXTRAPOLATION = 1.0;
+
 /// Index of the lower grid point and the fraction towards the next, clamped to the grid.
 std::pair<std::size_t, double> locate(const std::vector<double>& grid, double x) {
   if (grid.size() < 2 || x <= grid.front())
@@ -46,7 +48,13 @@ double RadiusCalibration::biasAt(double radius, double sigma) const {
   };
   if (noise.size() == 1)
     return row(0);
-  const auto [k, u] = locate(noise, sigma);
+  auto [k, u] = locate(noise, sigma);
+  // Past the noisiest row the bias keeps growing with the noise: continue the last two rows'
+  // line (up to MAX_NOISE_EXTRAPOLATION of their spacing) rather than hold the last row.
+  if (sigma > noise.back()) {
+    const double spacing = noise.back() - noise[noise.size() - 2];
+    u = 1.0 + std::min(MAX_NOISE_EXTRAPOLATION, (sigma - noise.back()) / spacing);
+  }
   return (1.0 - u) * row(k) + u * row(k + 1);
 }
 

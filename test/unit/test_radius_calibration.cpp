@@ -22,14 +22,19 @@ RadiusCalibration table() {
   return c;
 }
 
-TEST(RadiusCalibration, BilinearInsideAndHeldOutside) {
+TEST(RadiusCalibration, BilinearInsideHeldOutsideAndExtrapolatedAboveTheNoise) {
   const RadiusCalibration c = table();
   ASSERT_TRUE(c.valid());
   EXPECT_NEAR(c.biasAt(0.01, 0.002), 0.004, 1e-12);
   EXPECT_NEAR(c.biasAt(0.02, 0.002), 0.003, 1e-12);
   EXPECT_NEAR(c.biasAt(0.02, 0.004), 0.0045, 1e-12);  // mean of 3 and 6 mm
   EXPECT_NEAR(c.biasAt(0.005, 0.001), 0.004, 1e-12);  // below both axes: the corner
-  EXPECT_NEAR(c.biasAt(0.5, 0.5), 0.004, 1e-12);      // above both: the other corner
+  // Above the noisiest row the last two rows' line continues, for at most one row spacing:
+  // 8 mm is half a spacing past 6 mm, and 0.5 m is capped at 10 mm.
+  EXPECT_NEAR(c.biasAt(0.01, 0.008), 0.010, 1e-12);
+  EXPECT_NEAR(c.biasAt(0.5, 0.008), 0.005, 1e-12);  // radius held at 30 mm
+  EXPECT_NEAR(c.biasAt(0.5, 0.5), 0.006, 1e-12);
+  EXPECT_NEAR(c.biasAt(0.01, 0.5), 0.012, 1e-12);
 }
 
 TEST(RadiusCalibration, CorrectInvertsTheTable) {

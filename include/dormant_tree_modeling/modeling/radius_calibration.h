@@ -22,7 +22,10 @@ struct RadiusCalibration {
   /// @brief Whether the table is usable (non-empty, consistent sizes, ascending axes).
   bool valid() const;
 
-  /// @brief Bias at a true radius and noise, bilinear, held constant beyond the table.
+  /// @brief Bias at a true radius and noise, bilinear; held constant beyond the radii and
+  /// below the lowest noise, extrapolated along the two noisiest rows above the highest (up
+  /// to one row spacing further), where the modeler's estimate of heavy noise on real trees
+  /// runs past the reference scene's.
   double biasAt(double radius, double sigma) const;
 
   /// @brief The true radius whose apparent radius is `apparent` (inversion of
