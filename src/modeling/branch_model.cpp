@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "dormant_tree_modeling/modeling/point_index.h"
 
@@ -37,6 +38,17 @@ TrunkCoords locate(const TrunkModel& trunk, const Eigen::Vector3d& p) {
   if (c.segment >= 0)
     c.distance = axisDistance(trunk.cylinders[c.segment], p);
   return c;
+}
+
+/// A turned-down candidate: the centroid and count of its members (indices into pts).
+RejectedBranch rejection(const Points& pts, const std::vector<int>& members, std::string reason) {
+  RejectedBranch r;
+  for (const int k : members)
+    r.centroid += pts[k];
+  r.centroid /= static_cast<double>(members.size());
+  r.points = static_cast<int>(members.size());
+  r.reason = std::move(reason);
+  return r;
 }
 
 /// Closest points between two lines p + t u and q + s v: returns the point on the first line
@@ -165,8 +177,10 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     // A candidate that fits no branch may be several branches fused into one cluster (close
     // neighbours, a shoot bridging two): split in two by position and look at each half.
     auto reject = [&](const char* reason, bool splittable) {
-      if (splittable && config.ours_constrain_ransac && extractions < config.branch_search_budget &&
-          static_cast<int>(cluster.size()) >= 4 * config.branch_min_points) {
+      const bool could_split = splittable && config.ours_constrain_ransac &&
+                               static_cast<int>(cluster.size()) >= 4 * config.branch_min_points;
+      const bool budget_spent = extractions >= config.branch_search_budget;
+      if (could_split && !budget_spent) {
         Points cluster_pts;
         for (const int k : cluster)
           cluster_pts.push_back(cand_pts[k]);
@@ -181,17 +195,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
           return;
         }
       }
-      if (!rejected)
-        return;
-      RejectedBranch r;
-      for (const int k : cluster)
-        r.centroid += cand_pts[k];
-      r.centroid /= static_cast<double>(cluster.size());
-      r.points = static_cast<int>(cluster.size());
-      r.reason = reason;
-      if (splittable && config.ours_constrain_ransac && extractions >= config.branch_search_budget)
-        r.reason += " (search budget spent)";
-      rejected->push_back(r);
+      if (rejected) {
+        rejected->push_back(rejection(cand_pts, cluster,
+                                      could_split && budget_spent
+                                          ? std::string(reason) + " (search budget spent)"
+                                          : std::string(reason)));
+      }
     };
     if (static_cast<int>(sub.size()) < config.branch_min_points) {
       reject("too few points", false);
@@ -325,13 +334,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
           }
         } else if (rejected) {
           // Said, not silently dropped: what may hold another branch was not looked at.
-          RejectedBranch r;
-          for (const Eigen::Vector3d& p : rest_pts)
-            r.centroid += p;
-          r.centroid /= static_cast<double>(rest_pts.size());
-          r.points = static_cast<int>(rest.size());
-          r.reason = "remainder not searched (search budget spent)";
-          rejected->push_back(r);
+          rejected->push_back(
+              rejection(cand_pts, rest, "remainder not searched (search budget spent)"));
         }
       }
     }
