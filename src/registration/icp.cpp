@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
@@ -21,6 +22,43 @@ struct Match {
   double gap;       // how far apart the two are: 3-D, or across the ray for `across` pairs
   bool across;      // seen from opposite sides: point-to-ray
 };
+
+// A source axis sample paired with the other side's axis sample nearest to it.
+struct AxisMatch {
+  int source, target;
+  double gap;  // offset across the target axis
+};
+
+// Pairs of branch-axis samples seen from opposite sides: a station's estimate of a branch axis
+// from its half, against the other side's estimate from the other half.
+std::vector<AxisMatch> matchAxes(const AxisSamples& source, const AxisSamples& target,
+                                 const modeling::PointIndex& index, const Eigen::Isometry3d& t,
+                                 double limit, const IcpConfig& c) {
+  const double min_parallel = std::cos(c.axis_max_angle_deg * DEG);
+  std::vector<AxisMatch> found(source.size());
+  std::vector<char> valid(source.size(), 0);
+  parallelFor(static_cast<int>(source.size()), [&](int i) {
+    const Eigen::Vector3d p = t * source.points[i];
+    const int j = index.nearestOne(p);
+    if (j < 0 || (t.linear() * source.view_dirs[i]).dot(target.view_dirs[j]) >= c.across_cos)
+      return;
+    const Eigen::Vector3d& a = target.directions[j];
+    if (std::abs((t.linear() * source.directions[i]).dot(a)) < min_parallel)
+      return;
+    const Eigen::Vector3d d = p - target.points[j];
+    const double gap = (d - d.dot(a) * a).norm();
+    if (gap > limit)
+      return;
+    found[i] = {i, j, gap};
+    valid[i] = 1;
+  });
+  std::vector<AxisMatch> out;
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    if (valid[i])
+      out.push_back(found[i]);
+  }
+  return out;
+}
 
 // Two unit vectors spanning the plane normal to d.
 void planeBasis(const Eigen::Vector3d& d, Eigen::Vector3d& u, Eigen::Vector3d& v) {
@@ -47,6 +85,8 @@ void IcpConfig::validate() const {
   require(normal_neighbors >= 5, "normal_neighbors must be >= 5");
   require(across_cos >= -1 && across_cos <= 1, "across_cos must be in [-1, 1]");
   require(overlap_distance > 0, "overlap_distance must be > 0");
+  require(axis_max_angle_deg > 0 && axis_max_angle_deg < 90,
+          "axis_max_angle_deg must be in (0, 90)");
   require(min_rotation_step > 0 && min_translation_step > 0, "convergence steps must be > 0");
 }
 
@@ -71,6 +111,12 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
       throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
     const modeling::PointIndex index(target.points);
     const double limit = c.distance_factor * c.voxels[level];
+    // Axis pairs only where the estimates are meant to be read: at the finest level.
+    const bool use_axes = c.axis_pairs && level == levels - 1 && !source_p.axes.points.empty() &&
+                          !target_p.axes.points.empty();
+    std::optional<modeling::PointIndex> axis_index;
+    if (use_axes)
+      axis_index.emplace(target_p.axes.points);
     std::vector<Match> matches(source.size());
     std::vector<char> valid(source.size());
     r.converged = false;
@@ -100,20 +146,34 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
       std::vector<Match> used;
       std::size_t close = 0;
       for (std::size_t i = 0; i < source.size(); ++i) {
-        if (valid[i]) {
+        if (!valid[i])
+          continue;
+        close += matches[i].gap <= c.overlap_distance;
+        // With axis pairs, opposite halves say where the branch is through its axes only.
+        if (!(use_axes && matches[i].across))
           used.push_back(matches[i]);
-          close += matches[i].gap <= c.overlap_distance;
-        }
       }
       r.overlap = static_cast<double>(close) / source.size();
-      if (used.size() < 10)
+      std::vector<AxisMatch> axis_used;
+      if (use_axes) {
+        axis_used = matchAxes(source_p.axes, target_p.axes, *axis_index, r.transform, limit, c);
+        const std::size_t axis_keep = static_cast<std::size_t>(c.trim * axis_used.size());
+        if (axis_keep < axis_used.size()) {
+          std::nth_element(axis_used.begin(), axis_used.begin() + axis_keep, axis_used.end(),
+                           [](const AxisMatch& a, const AxisMatch& b) { return a.gap < b.gap; });
+          axis_used.resize(axis_keep);
+        }
+      }
+      if (used.size() + axis_used.size() < 10)
         throw Error(ErrorCode::EMPTY_INPUT, "ICP: the clouds do not overlap at the guess");
-      const std::size_t keep =
-          std::max<std::size_t>(10, static_cast<std::size_t>(c.trim * used.size()));
-      std::nth_element(used.begin(), used.begin() + (keep - 1), used.end(),
-                       [](const Match& a, const Match& b) {
-                         return std::abs(a.residual) < std::abs(b.residual);
-                       });
+      const std::size_t keep = std::min(
+          used.size(), std::max<std::size_t>(10, static_cast<std::size_t>(c.trim * used.size())));
+      if (keep > 0) {
+        std::nth_element(used.begin(), used.begin() + (keep - 1), used.end(),
+                         [](const Match& a, const Match& b) {
+                           return std::abs(a.residual) < std::abs(b.residual);
+                         });
+      }
       used.resize(keep);
       // Linearised point-to-plane step (small rotation w, translation t), Huber-weighted.
       Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
@@ -123,7 +183,10 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       for (const auto& m : used)
         centre += r.transform * source.points[m.source];
-      centre /= static_cast<double>(used.size());
+      for (const auto& m : axis_used)
+        centre += r.transform * source_p.axes.points[m.source];
+      const double pairs = static_cast<double>(used.size() + axis_used.size());
+      centre /= pairs;
       double sq = 0, radius_sq = 0;
       for (const auto& m : used) {
         const Eigen::Vector3d p = r.transform * source.points[m.source] - centre;
@@ -148,10 +211,25 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
         addRow(u, d.dot(u));
         addRow(v, d.dot(v));
       }
-      r.rmse = std::sqrt(sq / used.size());
+      for (const auto& m : axis_used) {
+        const Eigen::Vector3d p = r.transform * source_p.axes.points[m.source];
+        const Eigen::Vector3d d = p - target_p.axes.points[m.target];
+        radius_sq += (p - centre).squaredNorm();
+        sq += m.gap * m.gap;
+        const double w = m.gap <= c.huber ? 1.0 : c.huber / m.gap;
+        Eigen::Vector3d u, v;
+        planeBasis(target_p.axes.directions[m.target], u, v);
+        for (const Eigen::Vector3d& n : {u, v}) {
+          Eigen::Matrix<double, 6, 1> J;
+          J << (p - centre).cross(n), n;
+          A += w * J * J.transpose();
+          b -= w * J * d.dot(n);
+        }
+      }
+      r.rmse = std::sqrt(sq / pairs);
       {
         // Rotation rows scaled by the cloud's radius so both blocks are lengths.
-        const double scale = std::sqrt(radius_sq / used.size());
+        const double scale = std::sqrt(radius_sq / pairs);
         Eigen::Matrix<double, 6, 1> s;
         s << Eigen::Vector3d::Constant(1.0 / std::max(scale, 1e-6)), Eigen::Vector3d::Ones();
         const Eigen::Matrix<double, 6, 6> An = s.asDiagonal() * A * s.asDiagonal();

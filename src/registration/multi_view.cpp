@@ -83,6 +83,7 @@ std::string judge(const IcpResult& fit, const RegistrationConfig& c) {
 void RegistrationConfig::validate() const {
   icp.validate();
   coarse.validate();
+  axes.validate();
   auto require = [](bool ok, const char* m) {
     if (!ok)
       throw Error(ErrorCode::INVALID_ARGUMENT, std::string("registration: ") + m);
@@ -116,6 +117,7 @@ RegistrationResult registerViews(const std::vector<ViewInput>& views, const Regi
   }
   for (auto& s : stations) {
     Points pts, dirs;
+    std::vector<double> ranges;
     for (const int i : s.views) {
       const ViewInput& v = views[i];
       const Eigen::Vector3d sensor = v.in_station * v.sensor;
@@ -125,10 +127,16 @@ RegistrationResult registerViews(const std::vector<ViewInput>& views, const Regi
         const Eigen::Vector3d q = v.in_station * p;
         pts.push_back(q);
         const Eigen::Vector3d d = sensor - q;
+        ranges.push_back(d.norm());
         dirs.push_back(d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::Zero());
       }
     }
     s.pyramid = makePyramid(pts, dirs, c.icp.voxels, c.icp.normal_neighbors);
+    if (c.icp.axis_pairs) {
+      // One sample per source point of the finest ICP level (the level above the finest).
+      const std::size_t centres = s.pyramid.levels.size() >= 2 ? s.pyramid.levels.size() - 2 : 0;
+      s.pyramid.axes = estimateAxes(pts, dirs, ranges, s.pyramid.levels[centres].points, c.axes);
+    }
     if (s.pyramid.levels.back().size() < c.min_points) {
       s.rejected = true;
       s.reason = "too few points (" + std::to_string(s.pyramid.levels.back().size()) +

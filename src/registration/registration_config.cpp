@@ -28,6 +28,30 @@ RegistrationConfig loadRegistrationConfig(const std::string& path) {
                        c.icp.min_rotation_step = v.as<double>();
                      else if (key == "icp_min_translation_step")
                        c.icp.min_translation_step = v.as<double>();
+                     else if (key == "icp_axis_pairs")
+                       c.icp.axis_pairs = v.as<bool>();
+                     else if (key == "icp_axis_max_angle_deg")
+                       c.icp.axis_max_angle_deg = v.as<double>();
+                     else if (key == "axis_patch")
+                       c.axes.patch = v.as<double>();
+                     else if (key == "axis_min_points")
+                       c.axes.min_points = v.as<int>();
+                     else if (key == "axis_linearity")
+                       c.axes.linearity = v.as<double>();
+                     else if (key == "axis_max_view_cos")
+                       c.axes.max_view_cos = v.as<double>();
+                     else if (key == "axis_min_view_agreement")
+                       c.axes.min_view_agreement = v.as<double>();
+                     else if (key == "axis_min_radius")
+                       c.axes.min_radius = v.as<double>();
+                     else if (key == "axis_max_radius")
+                       c.axes.max_radius = v.as<double>();
+                     else if (key == "beam_exit")
+                       c.axes.beam_exit = v.as<double>();
+                     else if (key == "beam_divergence")
+                       c.axes.beam_divergence = v.as<double>();
+                     else if (key == "silhouette_fraction")
+                       c.axes.silhouette_fraction = v.as<double>();
                      else if (key == "coarse_cell")
                        c.coarse.cell = v.as<double>();
                      else if (key == "coarse_yaw_window_deg")

@@ -136,6 +136,7 @@ Pyramid transformed(const Pyramid& p, const Eigen::Isometry3d& t) {
   o.voxels = p.voxels;
   for (const auto& l : p.levels)
     o.levels.push_back(transformed(l, t));
+  appendTransformed(o.axes, p.axes, t);
   return o;
 }
 
@@ -148,6 +149,7 @@ void append(Pyramid& a, const Pyramid& b) {
     throw Error(ErrorCode::INVALID_ARGUMENT, "pyramids with different levels cannot be merged");
   for (std::size_t i = 0; i < a.levels.size(); ++i)
     append(a.levels[i], b.levels[i]);
+  appendTransformed(a.axes, b.axes, Eigen::Isometry3d::Identity());
 }
 
 }  // namespace registration

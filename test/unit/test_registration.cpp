@@ -169,9 +169,10 @@ TEST_F(MultiView, AlignsAFrontAndABackViewThatShareLittleSurface) {
   const auto [mm, deg] = worstError(views, r, {FRONT_LEFT, BACK_RIGHT});
   std::printf("[ INFO ] front/back pair: error %.1f mm, %.3f deg, overlap %.2f\n", mm, deg,
               r.views[1].overlap);
-  // One view per side is the hardest case: the two see opposite halves of every branch and
-  // pin the heading about the tree only weakly (the full plan does 3x better, see the bench).
-  EXPECT_LT(mm, 35.0);
+  // One view per side is the hardest case: the two see opposite halves of every branch (only
+  // the branch axes tie them: 26 mm without axis pairs, 7 mm with) and pin the heading about
+  // the tree only weakly (the full plan does better, see the bench).
+  EXPECT_LT(mm, 15.0);
   EXPECT_LT(deg, 1.0);
 }
 

@@ -23,6 +23,11 @@ struct IcpConfig {
   /// ray, so such a pair only counts its offset across the target point's ray (point-to-ray).
   /// Point-to-plane on them would pull the back of the tree into the front by ~1.3 radii.
   double across_cos = -0.3;
+  /// At the finest level, pair branch-axis samples (Pyramid::axes) of opposite sides and count
+  /// their offset across the target's axis; point pairs of opposite sides then only count
+  /// towards the overlap. Off: point-to-ray pairs, which leave the depth along the rays free.
+  bool axis_pairs = true;
+  double axis_max_angle_deg = 20.0;  ///< paired axes at most this far from parallel
   /// m: a source point counts towards the overlap when a target point lies this close (across
   /// the ray for pairs seen from opposite sides); ~2.5 sigma of the range noise.
   double overlap_distance = 0.015;
@@ -37,7 +42,7 @@ struct IcpConfig {
 /// @brief Result of one alignment.
 struct IcpResult {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();  ///< source -> target
-  double rmse = 0;  ///< m, point-to-plane, over the used pairs of the last level run
+  double rmse = 0;  ///< m, point-to-plane (axis pairs: across the axis), used pairs, last level
   double overlap =
       0;  ///< share of source points (last level) within overlap_distance of the target
   int iterations = 0;      ///< over all levels

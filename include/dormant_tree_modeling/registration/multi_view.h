@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/registration/branch_axes.h"
 #include "dormant_tree_modeling/registration/coarse_search.h"
 #include "dormant_tree_modeling/registration/icp.h"
 
@@ -15,6 +16,7 @@ namespace registration {
 struct RegistrationConfig {
   IcpConfig icp;
   CoarseSearchConfig coarse;
+  AxisConfig axes;  ///< branch axes per station (used when icp.axis_pairs)
   /// ICP levels (from the coarsest) run on each coarse candidate before the best is refined.
   int candidate_levels = 1;
   int refinement_rounds = 3;     ///< joint rounds: every station against all the others

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/registration/branch_axes.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
@@ -44,6 +45,9 @@ void append(Surface& a, const Surface& b);
 struct Pyramid {
   std::vector<double> voxels;
   std::vector<Surface> levels;
+  /// Branch-axis samples (estimateAxes); empty when not estimated. The finest level's ICP
+  /// pairs them across opposite sides.
+  AxisSamples axes;
 };
 
 /// @brief Build a pyramid; levels follow `voxels` (coarse to fine).
@@ -53,7 +57,7 @@ Pyramid makePyramid(const Points& pts, const Points& view_dirs, const std::vecto
 /// @brief The pyramid moved by a rigid transform.
 Pyramid transformed(const Pyramid& p, const Eigen::Isometry3d& t);
 
-/// @brief Append b's levels to a's (same voxel sizes; an empty a takes b's).
+/// @brief Append b's levels and axes to a's (same voxel sizes; an empty a takes b's).
 void append(Pyramid& a, const Pyramid& b);
 
 }  // namespace registration

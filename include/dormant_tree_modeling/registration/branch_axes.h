@@ -1,0 +1,65 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+
+namespace dormant_tree_modeling {
+namespace registration {
+
+using modeling::Points;
+
+/// @brief How branch axes are estimated from one side (registration.yaml `axis_*`, `beam_*`,
+/// `silhouette_fraction`). Lengths in m.
+///
+/// Why: a station sees only the half of each branch that faces it, and the station on the
+/// other side of the row sees the other half. Nearest points of the two halves are a diameter
+/// apart along the ray and say nothing about where the branch is along that ray, so ICP cannot
+/// tell a back station that sits a few millimetres too close. The axis of a branch is the one
+/// thing both sides see at the same place: each side estimates it from its own half (the
+/// silhouette gives the radius, the visible surface the depth).
+struct AxisConfig {
+  double patch = 0.1;         ///< diameter of the neighbourhood one axis sample is fitted on
+  int min_points = 15;        ///< fewer points in a patch: no sample
+  double linearity = 2.0;     ///< largest / second PCA eigenvalue at least this (a stick)
+  double max_view_cos = 0.5;  ///< |axis . view direction| at most this (seen from the side)
+  /// Mean resultant length of the patch's view directions at least this: one side only.
+  double min_view_agreement = 0.95;
+  double min_radius = 0.003;  ///< samples outside [min, max] radius are dropped (forks, trunk)
+  double max_radius = 0.04;
+  double beam_exit = 0.008;        ///< beam diameter at the optics (LMS111: 8 mm)
+  double beam_divergence = 0.015;  ///< rad, full angle (LMS111: 15 mrad)
+  /// Share of the beam footprint the silhouette grows by: a beam half on a branch still
+  /// returns (with the branch's range), so the visible width is 2r + fraction x footprint.
+  /// Depends on the sensor's detection threshold; calibrate against a pole of known diameter.
+  double silhouette_fraction = 0.3;
+  /// @throws Error INVALID_ARGUMENT naming the bad field
+  void validate() const;
+};
+
+/// @brief Branch-axis samples in one frame (parallel arrays).
+struct AxisSamples {
+  Points points;              ///< on the estimated axis
+  Points directions;          ///< unit axis directions (sign arbitrary)
+  Points view_dirs;           ///< unit directions towards the sensor that saw the half
+  std::vector<double> radii;  ///< m, estimated from the silhouette
+
+  std::size_t size() const { return points.size(); }
+};
+
+/// @brief Estimate branch-axis samples around sample centres from points seen from one side.
+/// @param pts the points (one station: one side of the tree)
+/// @param view_dirs unit directions from each point towards its sensor
+/// @param ranges each point's distance to its sensor (m): the beam footprint
+/// @param centres where samples are tried (e.g. the 2 cm voxel centres)
+/// @throws Error INVALID_ARGUMENT when the arrays differ in size or the config is bad
+AxisSamples estimateAxes(const Points& pts, const Points& view_dirs,
+                         const std::vector<double>& ranges, const Points& centres,
+                         const AxisConfig& config);
+
+/// @brief Append b moved by t to a.
+void appendTransformed(AxisSamples& a, const AxisSamples& b, const Eigen::Isometry3d& t);
+
+}  // namespace registration
+}  // namespace dormant_tree_modeling
