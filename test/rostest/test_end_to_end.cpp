@@ -2,12 +2,13 @@
 // stage_controller -> scan_assembler -> registration -> tree_modeler, sequenced by the
 // acquisition over the paper's 40-view plan with the virtual operator placing the platform.
 // The model must match the synthetic tree's truth and every node must report on /diagnostics.
-// The bounds leave room for one branch of the tree's seven: the platform runs in real time,
+// The bounds leave room for a few of the tree's 30 primaries: the platform runs in real time,
 // so which scan lines land in which view, and the registration after it, differ from run to
-// run (one CI run missed one branch: F1 0.93), and a single tree's F1 moves by a branch with
-// millimetre changes of its cloud. The accuracy targets are measured over 12 trees by
-// `make bench`; this test is about the parts working together. The bag and the model stay in
-// ~output_dir for the replay test (replay.test).
+// run (F1 over runs: 100, 98 and, once on CI, 93 %: two branches missed, two invented), and a
+// single tree's F1 moves by a branch with millimetre changes of its cloud. The accuracy
+// targets are measured over 12 trees by `make bench`; this test is about the parts working
+// together and fails when the model is wrong by more than one branch in ten. The bag and the model
+// stay in ~output_dir for the replay test (replay.test).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <dormant_tree_modeling/TreeModel.h>
 #include <gtest/gtest.h>
@@ -75,7 +76,7 @@ TEST(EndToEnd, VirtualPlatformToTreeModelMatchesTheTruth) {
   std::printf("%s", evaluation::formatTable({score}).c_str());
   RecordProperty("f1_percent", static_cast<int>(std::lround(100 * score.f1)));
   RecordProperty("branch_mae_um", static_cast<int>(std::lround(1e6 * score.branch_mae)));
-  EXPECT_GE(score.f1, 0.85) << "more than one primary branch missed or invented";
+  EXPECT_GE(score.f1, 0.90) << "more than one primary branch in ten missed or invented";
   EXPECT_LE(score.branch_mae, 0.008);
   EXPECT_TRUE(std::filesystem::exists(g_output_dir + "/e2e.bag")) << "the acquisition's bag";
 
