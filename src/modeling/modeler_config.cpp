@@ -66,6 +66,7 @@ const std::map<std::string, Setter>& setters() {
       {"disturbance_zero_run", setter(&C::disturbance_zero_run)},
       {"curvature_jump", setter(&C::curvature_jump)},
       {"min_segment_length", setter(&C::min_segment_length)},
+      {"trunk_max_bend", setter(&C::trunk_max_bend)},
       {"branch_cluster_tolerance", setter(&C::branch_cluster_tolerance)},
       {"branch_min_points", setter(&C::branch_min_points)},
       {"branch_fit_length", setter(&C::branch_fit_length)},
@@ -142,6 +143,7 @@ ModelerConfig ModelerConfig::paper() {
   c.ours_follow_diameter = false;
   c.ours_correct_noise_bias = false;
   c.ours_branch_shell = false;
+  c.trunk_max_bend = 0.0;
   return c;
 }
 
@@ -163,6 +165,7 @@ void ModelerConfig::validate() const {
   check("disturbance_zero_run", disturbance_zero_run, 1, 100);
   check("curvature_jump", curvature_jump, 0.01, 1.0);
   check("min_segment_length", min_segment_length, 0.02, 5.0);
+  check("trunk_max_bend", trunk_max_bend, 0.0, 1.0);
   check("branch_cluster_tolerance", branch_cluster_tolerance, 0.002, 0.5);
   check("branch_min_points", branch_min_points, 6, 1000000);
   check("branch_fit_length", branch_fit_length, 0.05, 2.0);

@@ -94,8 +94,11 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
                                            const TrunkPath& path, const ModelerConfig& config,
                                            std::vector<TrunkCandidate>* report) {
   double zmin = std::numeric_limits<double>::infinity();
-  for (const auto& c : clusters)
+  double zmax = -std::numeric_limits<double>::infinity();
+  for (const auto& c : clusters) {
     zmin = std::min(zmin, c.centroid.z());
+    zmax = std::max(zmax, c.centroid.z());
+  }
   std::vector<int> candidates{path.trunk.front()};
   for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
     const auto& fit = clusters[c].fit;
@@ -137,6 +140,18 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
     const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
     TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
+    // The free first circle can take in what stands around the base (suckers, weeds, soil
+    // pixels) and set a radius the trunk above never matches: a track that stops low is tried
+    // again from the start cluster's own radius, and the one that climbs higher is kept.
+    const auto climb = [&](const TrackedTrunk& t) {
+      return t.centers.empty() ? 0.0 : t.centers.back().z() - start.z();
+    };
+    if (climb(tracked) < 0.5 * (zmax - start.z())) {
+      TrackedTrunk retry =
+          trackTrunk(pts, index, start, up, first.radius, threshold, config, 4, true);
+      if (climb(retry) > climb(tracked))
+        tracked = std::move(retry);
+    }
     if (tracked.centers.size() < 3)
       return;
     // And down to the ground: where the first cluster begins is an accident of k-means.

@@ -322,7 +322,7 @@ double TrunkModel::baseZ() const {
 
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
-                        const ModelerConfig& config, int max_misses) {
+                        const ModelerConfig& config, int max_misses, bool trust_radius) {
   TrackedTrunk out;
   const double h = config.slice_height;
   Eigen::Vector3d c = start, t = direction.normalized();
@@ -333,7 +333,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     const Eigen::Vector3d predicted = c + h * t;
     // Until the first circle is found the start's radius is only a guess (a cluster's fit
     // to an arc of a thick trunk can be half its size): search wide, any trunk radius.
-    const bool first = out.centers.empty();
+    const bool first = out.centers.empty() && !trust_radius;
     const double lateral = first ? std::max(FIRST_WINDOW, 3.0 * r) : std::max(3.0 * r, r + 0.05);
     const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
     Points2 plane;
@@ -346,7 +346,8 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     o.threshold = threshold;
     o.iterations = config.ransac_iterations;
     o.min_radius = first ? MIN_TRUNK_RADIUS : std::max(MIN_TRUNK_RADIUS, 0.6 * r);
-    o.max_radius = first ? std::max(1.25 * r, 0.5 * FIRST_WINDOW) : 1.25 * r;
+    o.max_radius =
+        first ? std::max(1.25 * r, 0.5 * FIRST_WINDOW) : (out.centers.empty() ? 1.6 : 1.25) * r;
     o.seed = config.seed * 31337 + stream++;
     std::vector<int> inliers;
     std::optional<Circle> circle;
@@ -448,6 +449,35 @@ std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, doub
     cuts.push_back(top);
   return cuts;
 }
+
+namespace {
+
+// Cuts where the centreline bends: a stretch whose centreline leaves the chord between its
+// ends by more than max_bend is split where it leaves it most, recursively (a polyline
+// simplification of the centreline, at slice resolution).
+void splitAtBends(const Centerline& line, double a, double b, double step, double max_bend,
+                  double min_length, std::vector<double>& cuts) {
+  if (max_bend <= 0.0 || b - a < 2.0 * min_length)
+    return;
+  const Eigen::Vector3d p = line.pointAt(a), q = line.pointAt(b);
+  const Eigen::Vector3d chord = (q - p).normalized();
+  double worst = 0.0, at = a;
+  for (double t = a + min_length; t <= b - min_length + 1e-9; t += step) {
+    const Eigen::Vector3d d = line.pointAt(t) - p;
+    const double off = (d - d.dot(chord) * chord).norm();
+    if (off > worst) {
+      worst = off;
+      at = t;
+    }
+  }
+  if (worst <= max_bend)
+    return;
+  splitAtBends(line, a, at, step, max_bend, min_length, cuts);
+  cuts.push_back(at);
+  splitAtBends(line, at, b, step, max_bend, min_length, cuts);
+}
+
+}  // namespace
 
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
@@ -561,6 +591,15 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
       }
     }
     final_cuts.push_back(b);
+  }
+  if (config.trunk_max_bend > 0.0) {
+    std::vector<double> straight{final_cuts.front()};
+    for (std::size_t i = 1; i < final_cuts.size(); ++i) {
+      splitAtBends(line, straight.back(), final_cuts[i], h, config.trunk_max_bend,
+                   config.min_segment_length, straight);
+      straight.push_back(final_cuts[i]);
+    }
+    final_cuts = std::move(straight);
   }
   trunk.partitions = final_cuts;
   for (std::size_t i = 0; i + 1 < final_cuts.size(); ++i) {

@@ -73,6 +73,11 @@ struct ModelerConfig {
   bool branch_raw_radius = false;
 
   double trunk_max_tilt = 30.0;  ///< trunk cylinders' axes within this of vertical
+  /// A trunk segment whose centreline leaves the chord between its ends by more than this (m)
+  /// is split where it leaves it most (a leader that wanders off a straight line: one cylinder
+  /// over the bend lies centimetres off the wood and the branch search misplaces the trunk
+  /// surface). 0: off (the paper's segments).
+  double trunk_max_bend = 0.03;
   double radius_continuity =
       0.35;  ///< a trunk segment's radius within this share of its neighbour's
   /// Re-clusterings of what is left after a branch is taken out of a candidate cluster, and

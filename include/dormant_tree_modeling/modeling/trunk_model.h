@@ -85,9 +85,11 @@ struct TrackedTrunk {
 /// the thick continuation, a thin shoot is not), update centre, direction and radius, and stop
 /// after `max_misses` slices without an acceptable circle.
 /// @param index spatial index over pts
+/// @param trust_radius the first circle too stays near `radius` (0.6x..1.6x) instead of taking
+///        any trunk radius: the retry for a start whose free first circle took in clutter
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
-                        const ModelerConfig& config, int max_misses = 4);
+                        const ModelerConfig& config, int max_misses = 4, bool trust_radius = false);
 
 /// @brief Algorithm 3 steps 1-4 on the trunk region.
 
