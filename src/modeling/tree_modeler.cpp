@@ -29,6 +29,11 @@ constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trun
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
+// A track whose top third is at least this share of its bottom third's radius does not taper:
+// a trellis post or a pole, scored at POLE_WEIGHT (a tree's trunk tapers; one post beside a
+// tree gathers the tree's branches in its shell and outscored the trunk on two test trees).
+constexpr double POLE_TAPER = 0.9;
+constexpr double POLE_WEIGHT = 0.5;
 constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
 
 class Stopwatch {
@@ -172,7 +177,15 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     for (const auto& p : tracked.centers)
       lowest = std::min(lowest, p.z());
     const double floating = std::max(0.0, lowest - (zmin + GROUND_REACH)) / GROUND_REACH;
-    scores[k] = shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
+    const std::size_t third = tracked.radii.size() / 3;
+    double pole = 1.0;
+    if (third >= 3) {
+      const std::vector<double> lower(tracked.radii.begin(), tracked.radii.begin() + third);
+      const std::vector<double> upper(tracked.radii.end() - third, tracked.radii.end());
+      if (median(upper) >= POLE_TAPER * median(lower))
+        pole = POLE_WEIGHT;
+    }
+    scores[k] = pole * shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
     tracks[k] = std::move(tracked);
   });
   // Tracks from bases on one trunk follow one axis, except where one strays into a branch
