@@ -34,6 +34,8 @@ constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says w
 // tree gathers the tree's branches in its shell and outscored the trunk on two test trees).
 constexpr double POLE_TAPER = 0.9;
 constexpr double POLE_WEIGHT = 0.5;
+constexpr double RETRY_WIDTH =
+    1.6;  // first circle / start radius above which a low track is retried
 constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
 
 class Stopwatch {
@@ -146,12 +148,15 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
     TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
     // The free first circle can take in what stands around the base (suckers, weeds, soil
-    // pixels) and set a radius the trunk above never matches: a track that stops low is tried
-    // again from the start cluster's own radius, and the one that climbs higher is kept.
+    // pixels) and set a radius the trunk above never matches: a track that stops low after a
+    // first circle much wider than its start cluster is tried again from the cluster's own
+    // radius, and the one that climbs higher is kept.
     const auto climb = [&](const TrackedTrunk& t) {
       return t.centers.empty() ? 0.0 : t.centers.back().z() - start.z();
     };
-    if (climb(tracked) < 0.5 * (zmax - start.z())) {
+    const bool wide_first =
+        tracked.radii.empty() || tracked.radii.front() > RETRY_WIDTH * first.radius;
+    if (wide_first && climb(tracked) < 0.5 * (zmax - start.z())) {
       TrackedTrunk retry =
           trackTrunk(pts, index, start, up, first.radius, threshold, config, 4, true);
       if (climb(retry) > climb(tracked))
