@@ -6,6 +6,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -17,12 +18,6 @@ struct Sample {
   Eigen::Vector3d point, direction, view;
   double radius;
 };
-
-double median(std::vector<double>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 // One side's half of a branch around one centre: the axis from PCA, the radius from the
 // silhouette's width across the rays, the depth from the visible surface.

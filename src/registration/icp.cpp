@@ -187,44 +187,45 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
         centre += r.transform * source_p.axes.points[m.source];
       const double pairs = static_cast<double>(used.size() + axis_used.size());
       centre /= pairs;
+      // One linearised row: residual e along unit n at the centred point p, weight w.
+      auto addRow = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n, double e, double w) {
+        Eigen::Matrix<double, 6, 1> J;
+        J << p.cross(n), n;
+        A += w * J * J.transpose();
+        b -= w * J * e;
+      };
+      // The offset d counted only across a line of direction dir (a ray, a branch axis).
+      auto addAcross = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
+                           const Eigen::Vector3d& d, double w) {
+        Eigen::Vector3d u, v;
+        planeBasis(dir, u, v);
+        addRow(p, u, d.dot(u), w);
+        addRow(p, v, d.dot(v), w);
+      };
+      auto huberWeight = [&](double e) {
+        return std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
+      };
       double sq = 0, radius_sq = 0;
       for (const auto& m : used) {
-        const Eigen::Vector3d p = r.transform * source.points[m.source] - centre;
+        const Eigen::Vector3d q = r.transform * source.points[m.source];
+        const Eigen::Vector3d p = q - centre;
         radius_sq += p.squaredNorm();
-        const double w = std::abs(m.residual) <= c.huber ? 1.0 : c.huber / std::abs(m.residual);
+        const double w = huberWeight(m.residual);
         sq += m.residual * m.residual;
-        auto addRow = [&](const Eigen::Vector3d& n, double e) {
-          Eigen::Matrix<double, 6, 1> J;
-          J << p.cross(n), n;
-          A += w * J * J.transpose();
-          b -= w * J * e;
-        };
         if (!m.across) {
-          addRow(target.normals[m.target], m.residual);
+          addRow(p, target.normals[m.target], m.residual, w);
           continue;
         }
         // Seen from opposite sides, the two points lie on opposite halves of a branch: only
         // the offset across the target's ray says how far apart the branch axes are.
-        Eigen::Vector3d u, v;
-        planeBasis(target.view_dirs[m.target], u, v);
-        const Eigen::Vector3d d = r.transform * source.points[m.source] - target.points[m.target];
-        addRow(u, d.dot(u));
-        addRow(v, d.dot(v));
+        addAcross(p, target.view_dirs[m.target], q - target.points[m.target], w);
       }
       for (const auto& m : axis_used) {
-        const Eigen::Vector3d p = r.transform * source_p.axes.points[m.source];
-        const Eigen::Vector3d d = p - target_p.axes.points[m.target];
-        radius_sq += (p - centre).squaredNorm();
+        const Eigen::Vector3d q = r.transform * source_p.axes.points[m.source];
+        radius_sq += (q - centre).squaredNorm();
         sq += m.gap * m.gap;
-        const double w = m.gap <= c.huber ? 1.0 : c.huber / m.gap;
-        Eigen::Vector3d u, v;
-        planeBasis(target_p.axes.directions[m.target], u, v);
-        for (const Eigen::Vector3d& n : {u, v}) {
-          Eigen::Matrix<double, 6, 1> J;
-          J << (p - centre).cross(n), n;
-          A += w * J * J.transpose();
-          b -= w * J * d.dot(n);
-        }
+        addAcross(q - centre, target_p.axes.directions[m.target],
+                  q - target_p.axes.points[m.target], huberWeight(m.gap));
       }
       r.rmse = std::sqrt(sq / pairs);
       {

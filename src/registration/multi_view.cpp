@@ -127,8 +127,9 @@ RegistrationResult registerViews(const std::vector<ViewInput>& views, const Regi
         const Eigen::Vector3d q = v.in_station * p;
         pts.push_back(q);
         const Eigen::Vector3d d = sensor - q;
-        ranges.push_back(d.norm());
-        dirs.push_back(d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : Eigen::Vector3d::Zero());
+        const double range = d.norm();
+        ranges.push_back(range);
+        dirs.push_back(range > 0 ? Eigen::Vector3d(d / range) : Eigen::Vector3d::Zero());
       }
     }
     s.pyramid = makePyramid(pts, dirs, c.icp.voxels, c.icp.normal_neighbors);
