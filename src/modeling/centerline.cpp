@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "dormant_tree_modeling/modeling/trunk_model.h"
@@ -9,31 +10,41 @@ namespace modeling {
 Centerline::Centerline(std::vector<Eigen::Vector3d> vertices) : vertices_(std::move(vertices)) {
   cumulative_.push_back(0.0);
   for (std::size_t i = 1; i < vertices_.size(); ++i) {
-    cumulative_.push_back(cumulative_.back() + (vertices_[i] - vertices_[i - 1]).norm());
+    const Eigen::Vector3d ab = vertices_[i] - vertices_[i - 1];
+    const double length = ab.norm();
+    cumulative_.push_back(cumulative_.back() + length);
+    // Zero-length segments are kept (indices match the vertices) and never chosen.
+    Segment seg;
+    seg.direction = length > 0.0 ? Eigen::Vector3d(ab / length) : Eigen::Vector3d::Zero();
+    seg.length = length;
+    segments_.push_back(seg);
   }
 }
 
 double Centerline::project(const Eigen::Vector3d& p, double* distance) const {
-  double best_d = std::numeric_limits<double>::infinity(), best_s = 0.0;
-  const std::size_t n = vertices_.size();
-  for (std::size_t i = 0; i + 1 < n; ++i) {
-    const Eigen::Vector3d ab = vertices_[i + 1] - vertices_[i];
-    const double len2 = ab.squaredNorm();
-    if (len2 <= 0.0)
+  // Squared distances and unit directions: projection is the inner loop of the trunk region,
+  // the point classes and the branch step, over every point and every segment.
+  double best_d2 = std::numeric_limits<double>::infinity(), best_s = 0.0;
+  const std::size_t n = segments_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Segment& seg = segments_[i];
+    if (seg.length <= 0.0)
       continue;
-    double t = (p - vertices_[i]).dot(ab) / len2;
+    const Eigen::Vector3d w = p - vertices_[i];
+    double t = w.dot(seg.direction);
     // Beyond the first and last vertex the end segments extend the line.
-    const double lo = i == 0 ? -std::numeric_limits<double>::infinity() : 0.0;
-    const double hi = i + 2 == n ? std::numeric_limits<double>::infinity() : 1.0;
-    t = std::clamp(t, lo, hi);
-    const double d = (vertices_[i] + t * ab - p).norm();
-    if (d < best_d) {
-      best_d = d;
-      best_s = cumulative_[i] + t * std::sqrt(len2);
+    if (i > 0)
+      t = std::max(t, 0.0);
+    if (i + 1 < n)
+      t = std::min(t, seg.length);
+    const double d2 = (w - t * seg.direction).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best_s = cumulative_[i] + t;
     }
   }
   if (distance)
-    *distance = best_d;
+    *distance = std::sqrt(best_d2);
   return best_s;
 }
 

@@ -31,17 +31,19 @@ std::optional<Circle> fitCircle(const Points2& pts) {
   for (const auto& p : pts)
     mean += p;
   mean /= n;
-  // Kasa: x^2 + y^2 + D x + E y + F = 0, linear least squares (centred for conditioning).
-  Eigen::MatrixXd A(n, 3);
-  Eigen::VectorXd b(n);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d q = pts[i] - mean;
-    A(i, 0) = q.x();
-    A(i, 1) = q.y();
-    A(i, 2) = 1.0;
-    b(i) = -q.squaredNorm();
+  // Kasa: x^2 + y^2 + D x + E y + F = 0, linear least squares on centred points (normal
+  // equations: 3 unknowns, no n x 3 matrix on the heap; centring keeps them well conditioned).
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  for (const auto& p : pts) {
+    const Eigen::Vector2d q = p - mean;
+    const Eigen::Vector3d row(q.x(), q.y(), 1.0);
+    AtA.noalias() += row * row.transpose();
+    Atb -= row * q.squaredNorm();
   }
-  const Eigen::Vector3d s = A.colPivHouseholderQr().solve(b);
+  const Eigen::Vector3d s = AtA.ldlt().solve(Atb);
+  if (!s.allFinite())
+    return std::nullopt;
   Circle c;
   c.center = Eigen::Vector2d(-0.5 * s(0), -0.5 * s(1));
   const double r2 = c.center.squaredNorm() - s(2);

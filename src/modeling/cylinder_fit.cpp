@@ -108,7 +108,7 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
         // Derivatives of the distance: centre shift along u, v; axis tilt towards u, v; radius.
         Eigen::Matrix<double, 5, 1> J;
         J << -n.dot(u), -n.dot(v), -t * n.dot(u), -t * n.dot(v), -1.0;
-        JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J);
+        JtJ.noalias() += J * J.transpose();  // fixed-size outer product: unrolled
         Jtr += J * (d - r);
         cost += (d - r) * (d - r);
       }
@@ -122,7 +122,6 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
       previous_c = c;
       previous_a = a;
       previous_r = r;
-      JtJ = JtJ.selfadjointView<Eigen::Lower>();
       JtJ.diagonal() *= 1.0 + 1e-6;
       const Eigen::Matrix<double, 5, 1> step = JtJ.ldlt().solve(-Jtr);
       if (!step.allFinite())

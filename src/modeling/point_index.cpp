@@ -73,18 +73,35 @@ int PointIndex::nearestOne(const Eigen::Vector3d& q, float* squared_distance) co
   return static_cast<int>(i);
 }
 
+namespace {
+
+/// FLANN's RadiusResultSet without its (distance, index) pairs and their copy: indices go
+/// straight into the caller's vector, in the order the search finds them, as the set keeps them.
+class IndexCollector : public flann::ResultSet<float> {
+ public:
+  IndexCollector(float squared_radius, std::vector<int>& out)
+      : squared_radius_(squared_radius), out_(out) {}
+  bool full() const override { return true; }
+  void addPoint(float dist, std::size_t index) override {
+    if (dist < squared_radius_)
+      out_.push_back(static_cast<int>(index));
+  }
+  float worstDist() const override { return squared_radius_; }
+
+ private:
+  float squared_radius_;
+  std::vector<int>& out_;
+};
+
+}  // namespace
+
 std::vector<int> PointIndex::within(const Eigen::Vector3d& q, double radius) const {
   std::vector<int> idx;
   if (size_ == 0)
     return idx;
-  flann::RadiusResultSet<float> result(static_cast<float>(radius * radius));
+  IndexCollector result(static_cast<float>(radius * radius), idx);
   const auto v = impl_->query(q);
   impl_->tree->findNeighbors(result, v.data(), impl_->params);
-  std::vector<std::size_t> found(result.size());
-  std::vector<float> dist(result.size());
-  if (!found.empty())
-    result.copy(found.data(), dist.data(), found.size(), false);
-  idx.assign(found.begin(), found.end());
   return idx;
 }
 

@@ -3,7 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
 
+#include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/common/statistics.h"
@@ -187,20 +192,52 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
   return removed;
 }
 
-using CellKey = std::array<long, 3>;
+/// Grid cells keyed by one integer: per axis the offset from one cell below the cloud's lowest,
+/// packed with x in the highest bits, so the keys sort as (x, y, z) do. Each axis has a spare
+/// cell at both ends: a face neighbour's key is the key plus or minus that axis's unit.
+struct CellKeys {
+  std::vector<std::pair<std::uint64_t, int>> keyed;  ///< (key, point index), sorted
+  std::array<std::uint64_t, 3> unit{};               ///< key step of one cell along x, y, z
+};
 
 /// Every point's grid cell (edge `cell`) with its index, sorted by cell and then by index:
 /// each cell's points form one run, in input order.
-std::vector<std::pair<CellKey, int>> sortedByCell(const Points& pts, double cell) {
-  std::vector<std::pair<CellKey, int>> keyed(pts.size());
+CellKeys sortedByCell(const Points& pts, double cell) {
+  CellKeys out;
+  out.keyed.resize(pts.size());
+  if (pts.empty())
+    return out;
+  std::vector<std::array<long, 3>> cells(pts.size());
+  std::array<long, 3> lo, hi;
+  lo.fill(std::numeric_limits<long>::max());
+  hi.fill(std::numeric_limits<long>::min());
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    keyed[i] = {CellKey{static_cast<long>(std::floor(pts[i].x() / cell)),
-                        static_cast<long>(std::floor(pts[i].y() / cell)),
-                        static_cast<long>(std::floor(pts[i].z() / cell))},
-                static_cast<int>(i)};
+    for (int a = 0; a < 3; ++a) {
+      cells[i][a] = static_cast<long>(std::floor(pts[i](a) / cell));
+      lo[a] = std::min(lo[a], cells[i][a]);
+      hi[a] = std::max(hi[a], cells[i][a]);
+    }
   }
-  std::sort(keyed.begin(), keyed.end());
-  return keyed;
+  std::array<int, 3> bits;
+  for (int a = 0; a < 3; ++a) {
+    bits[a] = 1;
+    while (bits[a] < 63 && (1UL << bits[a]) < static_cast<std::uint64_t>(hi[a] - lo[a] + 3))
+      ++bits[a];
+  }
+  if (bits[0] + bits[1] + bits[2] > 64) {
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "the cloud spans more grid cells of " + std::to_string(cell) +
+                    " m than 64-bit keys hold; use a larger cell (voxel_size)");
+  }
+  out.unit = {1UL << (bits[1] + bits[2]), 1UL << bits[2], 1UL};
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    std::uint64_t key = 0;
+    for (int a = 0; a < 3; ++a)
+      key += static_cast<std::uint64_t>(cells[i][a] - lo[a] + 1) * out.unit[a];
+    out.keyed[i] = {key, static_cast<int>(i)};
+  }
+  std::sort(out.keyed.begin(), out.keyed.end());
+  return out;
 }
 
 }  // namespace
@@ -229,7 +266,7 @@ Points voxelDownsample(const Points& pts, double voxel) {
     return pts;
   // Sort the points by voxel (x, then y, then z), stably, and average each run: the same
   // cells, order and sums as a map of voxels, without a tree node per voxel.
-  const auto keyed = sortedByCell(pts, voxel);
+  const auto keyed = sortedByCell(pts, voxel).keyed;
   Points out;
   for (std::size_t i = 0; i < keyed.size();) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -246,29 +283,62 @@ Points voxelDownsample(const Points& pts, double voxel) {
 }
 
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
+  return floatingMask(pts, nullptr, radius, min_neighbors);
+}
+
+std::vector<char> floatingMask(const Points& pts, const PointIndex* index, double radius,
+                               int min_neighbors) {
   std::vector<char> mask(pts.size(), 0);
-  // Any two points in a cube whose diagonal is under the radius are neighbours: a point
-  // sharing such a cell with min_neighbors others is settled without a search (most points
-  // of a dense scan); only the others go to the k-d tree. Same answer, a fraction of the work.
-  const double cell = 0.95 * radius / std::sqrt(3.0);
-  const auto keyed = sortedByCell(pts, cell);
+  // Cells of edge h = 0.95 radius / sqrt(6): any point of a cell is within the radius of any
+  // point of the same cell or of a face-adjacent one (at most h sqrt(6) apart). A cell whose
+  // block of seven holds more than min_neighbors points settles all its points without a
+  // search (most points of a dense scan); only the others go to the k-d tree. Same answer.
+  const double cell = 0.95 * radius / std::sqrt(6.0);
+  const CellKeys grid = sortedByCell(pts, cell);
+  const auto& keyed = grid.keyed;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::size_t> first;  // each cell's first entry in keyed; one past the end last
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    if (i == 0 || keyed[i].first != keyed[i - 1].first) {
+      keys.push_back(keyed[i].first);
+      first.push_back(i);
+    }
+  }
+  first.push_back(keyed.size());
+  const std::size_t cells = keys.size();
+  std::vector<int> block(cells);
+  for (std::size_t c = 0; c < cells; ++c)
+    block[c] = static_cast<int>(first[c + 1] - first[c]);
+  // The keys are sorted, and so are the keys shifted by one face: each neighbour is found by
+  // one pointer walking along with the cells (a merge), not by a search per cell.
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const long step : {-1L, 1L}) {
+      std::size_t p = 0;
+      for (std::size_t c = 0; c < cells; ++c) {
+        const std::uint64_t target =
+            step > 0 ? keys[c] + grid.unit[axis] : keys[c] - grid.unit[axis];
+        while (p < cells && keys[p] < target)
+          ++p;
+        if (p < cells && keys[p] == target)
+          block[c] += static_cast<int>(first[p + 1] - first[p]);
+      }
+    }
+  }
   std::vector<int> open;
-  for (std::size_t i = 0; i < keyed.size();) {
-    std::size_t j = i;
-    while (j < keyed.size() && keyed[j].first == keyed[i].first)
-      ++j;
-    if (static_cast<int>(j - i) <= min_neighbors) {
-      for (std::size_t k = i; k < j; ++k)
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (block[c] <= min_neighbors) {
+      for (std::size_t k = first[c]; k < first[c + 1]; ++k)
         open.push_back(keyed[k].second);
     }
-    i = j;
   }
   if (open.empty())
     return mask;
-  const PointIndex index(pts);
+  std::optional<PointIndex> own;
+  if (!index)
+    index = &own.emplace(pts);
   parallelFor(static_cast<int>(open.size()), [&](int k) {
     const int i = open[k];
-    mask[i] = index.countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
+    mask[i] = index->countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
   });
   return mask;
 }
@@ -280,13 +350,15 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
   s.after_voxel = out.size();
   if (config.ours_remove_clutter) {
     double radius = config.floating_radius;
-    if (config.ours_derive_parameters) {
+    std::optional<PointIndex> index;
+    if (config.ours_derive_parameters && out.size() >= 2) {
       // Sparse clouds (terrestrial scans of whole trees, a few cm between returns) would lose
       // everything to a fixed radius: scale it with the median nearest-neighbour spacing.
-      radius = std::max(radius, 3.0 * medianSpacing(out));
+      radius = std::max(radius, 3.0 * medianSpacing(out, index.emplace(out)));
     }
     s.floating_radius = radius;
-    const auto mask = floatingMask(out, radius, config.floating_min_neighbors);
+    const auto mask =
+        floatingMask(out, index ? &*index : nullptr, radius, config.floating_min_neighbors);
 
     Points kept;
     for (std::size_t i = 0; i < out.size(); ++i) {

@@ -413,11 +413,15 @@ ModelResult TreeModeler::model(const Points& input) const {
   model.input_points = input.size();
   result.classes.assign(pts.size(), PointClass::OTHER);
   const double base_z = trunk.baseZ();
+  std::vector<double> region_s(region.size());
+  parallelFor(static_cast<int>(region.size()),
+              [&](int k) { region_s[k] = trunk.centerline.project(pts[region[k]]); });
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
     const Cylinder& c = trunk.cylinders[i];
     std::size_t inliers = 0, total = 0;
-    for (const int k : region) {
-      const double s = trunk.centerline.project(pts[k]);
+    for (std::size_t j = 0; j < region.size(); ++j) {
+      const int k = region[j];
+      const double s = region_s[j];
       if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second)
         continue;
       ++total;

@@ -31,6 +31,10 @@ Points voxelDownsample(const Points& pts, double voxel);
 /// @brief Points with fewer than min_neighbors others within radius: floating pixels.
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors);
 
+/// @brief floatingMask with an index of pts that already exists (nullptr: built if needed).
+std::vector<char> floatingMask(const Points& pts, const PointIndex* index, double radius,
+                               int min_neighbors);
+
 /// @brief Downsample and, with config.ours_remove_clutter, drop floating pixels, the ground
 /// plane and trellis wires (long straight thin near-horizontal runs).
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats);

@@ -27,7 +27,12 @@ class Centerline {
 
  private:
   std::size_t segmentAt(double s) const;
+  struct Segment {
+    Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit, from vertex i to i + 1
+    double length = 0.0;
+  };
   std::vector<Eigen::Vector3d> vertices_;
+  std::vector<Segment> segments_;
   std::vector<double> cumulative_;
 };
 

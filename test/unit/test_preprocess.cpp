@@ -1,0 +1,112 @@
+// Preprocessing: the voxel grid and the floating-pixel mask against brute force.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
+#include "dormant_tree_modeling/modeling/preprocess.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+/// A dense surface, a sparse haze and isolated points, off the origin and across cell borders
+/// of every sign: every case of the cell shortcut and of the search behind it. (The k-d tree
+/// is single precision: the modeler takes survey coordinates to a local origin first.)
+Points mixedCloud(std::uint64_t seed) {
+  Rng rng(seed);
+  const Eigen::Vector3d far(-3.0, 12.0, 0.2);
+  Points pts;
+  for (int i = 0; i < 4000; ++i) {  // a 4 cm cylinder, 0.5 m tall
+    const double a = rng.uniform(0.0, 2.0 * M_PI);
+    pts.push_back(far +
+                  Eigen::Vector3d(0.04 * std::cos(a), 0.04 * std::sin(a), rng.uniform(0.0, 0.5)));
+  }
+  for (int i = 0; i < 1500; ++i)  // haze: a few neighbours each, at best
+    pts.push_back(far + Eigen::Vector3d(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3),
+                                        rng.uniform(0.0, 0.5)));
+  return pts;
+}
+
+TEST(FloatingMask, SameAnswerAsABruteForceCount) {
+  for (const std::uint64_t seed : {3u, 4u}) {
+    const Points pts = mixedCloud(seed);
+    for (const double radius : {0.01, 0.02, 0.035}) {
+      for (const int min_neighbors : {1, 4, 9}) {
+        const auto mask = floatingMask(pts, radius, min_neighbors);
+        int floating = 0, mismatches = 0;
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          int others = 0;
+          bool borderline = false;  // the k-d tree measures in single precision
+          for (std::size_t j = 0; j < pts.size(); ++j) {
+            const double d = (pts[j] - pts[i]).norm();
+            others += j != i && d < radius;
+            borderline = borderline || std::abs(d - radius) < 1e-6;
+          }
+          const bool expected = others < min_neighbors;
+          floating += expected;
+          mismatches += !borderline && expected != static_cast<bool>(mask[i]);
+        }
+        EXPECT_EQ(mismatches, 0) << "radius " << radius << " min " << min_neighbors;
+        EXPECT_GT(floating, 0);
+        EXPECT_LT(floating, static_cast<int>(pts.size()));
+        // With an index of the same points: the same mask.
+        const PointIndex index(pts);
+        EXPECT_EQ(floatingMask(pts, &index, radius, min_neighbors), mask);
+      }
+    }
+  }
+}
+
+TEST(VoxelDownsample, OneMeanPerOccupiedCellInCellOrder) {
+  Rng rng(9);
+  Points pts;
+  const Eigen::Vector3d far(-250000.0, 40.0, -12.0);
+  for (int i = 0; i < 3000; ++i)
+    pts.push_back(far +
+                  Eigen::Vector3d(rng.uniform(0, 0.2), rng.uniform(0, 0.1), rng.normal(0, 0.05)));
+  const double voxel = 0.02;
+  const Points out = voxelDownsample(pts, voxel);
+  // Brute force: cells as integer triples, sorted; one mean each.
+  std::vector<std::pair<std::array<long, 3>, Eigen::Vector3d>> cells;
+  for (const auto& p : pts) {
+    cells.push_back({{static_cast<long>(std::floor(p.x() / voxel)),
+                      static_cast<long>(std::floor(p.y() / voxel)),
+                      static_cast<long>(std::floor(p.z() / voxel))},
+                     p});
+  }
+  std::stable_sort(cells.begin(), cells.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  Points expected;
+  for (std::size_t i = 0; i < cells.size();) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t j = i;
+    for (; j < cells.size() && cells[j].first == cells[i].first; ++j)
+      sum += cells[j].second;
+    expected.push_back(sum / static_cast<double>(j - i));
+    i = j;
+  }
+  ASSERT_EQ(out.size(), expected.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    EXPECT_EQ(out[i], expected[i]) << i;
+}
+
+TEST(VoxelDownsample, AGridTooFineForItsKeysIsAClearError) {
+  // 2 km at 1 nm cells in every axis: 3 x 41 bits, more than one 64-bit key holds.
+  const Points pts{Eigen::Vector3d::Zero(), Eigen::Vector3d(2000.0, 2000.0, 2000.0)};
+  // (Survey coordinates themselves are fine: the keys count cells from the cloud's corner.)
+  try {
+    voxelDownsample(pts, 1e-9);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::INVALID_ARGUMENT);
+    EXPECT_NE(std::string(e.what()).find("voxel_size"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
