@@ -67,6 +67,7 @@ const std::map<std::string, Setter>& setters() {
       {"curvature_jump", setter(&C::curvature_jump)},
       {"min_segment_length", setter(&C::min_segment_length)},
       {"trunk_max_bend", setter(&C::trunk_max_bend)},
+      {"trunk_taper_profile", setter(&C::trunk_taper_profile)},
       {"branch_cluster_tolerance", setter(&C::branch_cluster_tolerance)},
       {"branch_min_points", setter(&C::branch_min_points)},
       {"branch_fit_length", setter(&C::branch_fit_length)},
@@ -144,6 +145,7 @@ ModelerConfig ModelerConfig::paper() {
   c.ours_correct_noise_bias = false;
   c.ours_branch_shell = false;
   c.trunk_max_bend = 0.0;
+  c.trunk_taper_profile = false;
   return c;
 }
 

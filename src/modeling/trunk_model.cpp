@@ -11,6 +11,7 @@
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
+#include "dormant_tree_modeling/modeling/taper_profile.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -24,6 +25,10 @@ constexpr double MIN_TRUNK_RADIUS = 0.003;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
 constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
 constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
+// Robust sigmas under and over the taper profile a slice may read and stay in its fit: slices
+// through branch bases read wide, never narrow.
+constexpr double TAPER_BELOW = 2.5;
+constexpr double TAPER_ABOVE = 2.0;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -620,6 +625,14 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
+  if (config.ours_correct_noise_bias && config.trunk_taper_profile) {
+    if (const auto profile = TaperProfile::fit(slices, h, TAPER_BELOW, TAPER_ABOVE)) {
+      for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+        const auto& [a, b] = trunk.cylinder_ranges[i];
+        trunk.cylinders[i].radius = std::max(MIN_TRUNK_RADIUS, profile->mean(a, b));
+      }
+    }
+  }
   if (config.ours_constrain_ransac) {
     // A trunk tapers: a segment measured thicker than the one below it by more than a swelling
     // at a whorl has circles through branch bases or noise wider than its radius (the thin

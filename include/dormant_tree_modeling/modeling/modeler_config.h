@@ -78,6 +78,9 @@ struct ModelerConfig {
   /// over the bend lies centimetres off the wood and the branch search misplaces the trunk
   /// surface). 0: off (the paper's segments).
   double trunk_max_bend = 0.03;
+  /// With ours_correct_noise_bias: trunk segment radii from one smooth taper profile fitted to
+  /// all slices (robust to slices through branch bases), not each segment's median slice.
+  bool trunk_taper_profile = true;
   double radius_continuity =
       0.35;  ///< a trunk segment's radius within this share of its neighbour's
   /// Re-clusterings of what is left after a branch is taken out of a candidate cluster, and
