@@ -15,6 +15,13 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
+// Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
+// DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
+// other's axis and the centres within DUPLICATE_REACH.
+constexpr double DUPLICATE_MAX_ANGLE = 25.0 * DEG;
+constexpr double DUPLICATE_ATTACHMENT_GAP = 0.06;  // m
+constexpr double DUPLICATE_LINE_GAP = 0.02;        // m
+constexpr double DUPLICATE_REACH = 0.4;            // m
 
 /// Where a point sits relative to the trunk model.
 struct TrunkCoords {
@@ -97,6 +104,20 @@ bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const Point
 }
 
 }  // namespace
+
+bool sameBranch(const BranchFit& a, const BranchFit& b) {
+  const Cylinder &ca = a.cylinder, &cb = b.cylinder;
+  const double angle = std::acos(std::clamp(ca.axis.dot(cb.axis), -1.0, 1.0));
+  if (angle >= DUPLICATE_MAX_ANGLE)
+    return false;
+  if ((a.attachment - b.attachment).norm() < DUPLICATE_ATTACHMENT_GAP)
+    return true;
+  // Pieces of one branch lie on one line: on a steep branch the attachment (where its axis
+  // passes the trunk's) is ill-conditioned, and two pieces of it attach centimetres apart.
+  const double off_line = std::max(axisDistance(ca, cb.center), axisDistance(cb, ca.center));
+  return off_line < std::max(DUPLICATE_LINE_GAP, ca.radius + cb.radius) &&
+         (ca.center - cb.center).norm() < DUPLICATE_REACH;
+}
 
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
@@ -347,9 +368,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
         if (drop[i] || drop[k])
           continue;
-        const double angle = std::acos(
-            std::clamp(branches[i].cylinder.axis.dot(branches[k].cylinder.axis), -1.0, 1.0));
-        if ((branches[i].attachment - branches[k].attachment).norm() < 0.06 && angle < 25.0 * DEG) {
+        if (sameBranch(branches[i], branches[k])) {
           const std::size_t loser =
               branches[i].inliers.size() >= branches[k].inliers.size() ? k : i;
           drop[loser] = 1;

@@ -428,6 +428,40 @@ TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   EXPECT_EQ(unsearched, 1) << "the lost branch is reported";
 }
 
+TEST(BranchModel, PiecesOfOneSteepBranchAreOneBranch) {
+  const auto fit = [](const Eigen::Vector3d& centre, const Eigen::Vector3d& axis, double radius,
+                      const Eigen::Vector3d& attachment) {
+    BranchFit f;
+    f.cylinder.center = centre;
+    f.cylinder.axis = axis.normalized();
+    f.cylinder.radius = radius;
+    f.cylinder.length = 0.2;
+    f.attachment = attachment;
+    return f;
+  };
+  // A branch leaving at 50 deg elevation; two pieces of it 17 cm apart, their fitted axes
+  // 3 deg apart, attached 9 cm apart on the trunk axis.
+  const Eigen::Vector3d up(std::cos(50.0 * M_PI / 180.0), 0.0, std::sin(50.0 * M_PI / 180.0));
+  const Eigen::Vector3d base(0.04, 0.0, 1.5);
+  const BranchFit near = fit(base + 0.12 * up, up, 0.018, {0, 0, 1.50});
+  const Eigen::Vector3d tilted =
+      Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()) * up;
+  const BranchFit far =
+      fit(base + 0.29 * up + Eigen::Vector3d(0, 0.004, 0), tilted, 0.014, {0, 0, 1.59});
+  EXPECT_TRUE(sameBranch(near, far));
+  EXPECT_TRUE(sameBranch(far, near));
+  // Two branches side by side, parallel, 5 cm apart, attached 9 cm apart: two branches.
+  const BranchFit beside =
+      fit(base + 0.12 * up + Eigen::Vector3d(0, 0.05, 0), up, 0.015, {0, 0, 1.59});
+  EXPECT_FALSE(sameBranch(near, beside));
+  // One crotch, two branches 30 deg apart: two branches, however close their attachments.
+  const Eigen::Vector3d other =
+      Eigen::AngleAxisd(30.0 * M_PI / 180.0, up.cross(Eigen::Vector3d::UnitY()).normalized()) * up;
+  EXPECT_FALSE(sameBranch(near, fit(base + 0.12 * other, other, 0.018, {0, 0, 1.50})));
+  // The same line, but a metre further out: not a piece of this branch.
+  EXPECT_FALSE(sameBranch(near, fit(base + 1.12 * up, up, 0.018, {0, 0, 1.70})));
+}
+
 TEST(TrunkModel, TooLittleIsNoTrunk) {
   ModelerConfig config;
   try {

@@ -29,6 +29,12 @@ struct RejectedBranch {
                        ///< " (search budget spent)" when it was not split for lack of budget
 };
 
+/// @brief Whether two detections are one branch (a gap in its returns split it into two
+/// clusters): their axes within 25 deg and either their attachments within 6 cm or each
+/// centre on the other's axis line (within 2 cm or the sum of their radii) with the centres
+/// within 0.4 m.
+bool sameBranch(const BranchFit& a, const BranchFit& b);
+
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
 /// config.ours_branch_shell, every point of the cloud in a shell around the trunk cylinders.
