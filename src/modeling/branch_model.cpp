@@ -15,6 +15,7 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
+constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
 // other's axis and the centres within DUPLICATE_REACH.
@@ -229,7 +230,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     }
     const Cylinder& seg = trunk.cylinders[segment];
     Eigen::Vector3d centroid;
-    Eigen::Vector3d axis = principalAxis(sub, &centroid);
+    Eigen::Vector3d spread;
+    Eigen::Vector3d axis = principalAxis(sub, &centroid, &spread);
     Eigen::Vector3d radial =
         (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
     if (radial.norm() < 1e-9) {
@@ -239,7 +241,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     radial.normalize();
     if (axis.dot(radial) < 0.0)
       axis = -axis;
-    const double max_angle = config.branch_max_radial_angle * DEG;
+    // A steep scaffold (central leaders) leaves the trunk more upwards than outwards; its part
+    // in the shell is a long, clearly directed cluster, and its own direction is kept up to
+    // branch_max_steep_angle from the radial. A short or round cluster's direction says
+    // little: the radial replaces it beyond branch_max_radial_angle.
+    const bool elongated = spread(2) > STEEP_ELONGATION * spread(1);
+    const double max_angle =
+        (elongated ? config.branch_max_steep_angle : config.branch_max_radial_angle) * DEG;
     if (config.ours_constrain_ransac &&
         std::acos(std::clamp(axis.dot(radial), -1.0, 1.0)) > max_angle)
       axis = radial;

@@ -83,6 +83,7 @@ const std::map<std::string, Setter>& setters() {
       {"radius_continuity", setter(&C::radius_continuity)},
       {"branch_search_budget", setter(&C::branch_search_budget)},
       {"branch_max_radial_angle", setter(&C::branch_max_radial_angle)},
+      {"branch_max_steep_angle", setter(&C::branch_max_steep_angle)},
       {"branch_max_azimuth", setter(&C::branch_max_azimuth)},
       {"branch_min_elevation", setter(&C::branch_min_elevation)},
       {"branch_max_diameter_ratio", setter(&C::branch_max_diameter_ratio)},
@@ -178,6 +179,7 @@ void ModelerConfig::validate() const {
   check("radius_continuity", radius_continuity, 0.01, 10.0);
   check("branch_search_budget", branch_search_budget, 0, 1000000);
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
+  check("branch_max_steep_angle", branch_max_steep_angle, branch_max_radial_angle, 90.0);
   check("branch_max_azimuth", branch_max_azimuth, 1.0, 180.0);
   check("branch_min_elevation", branch_min_elevation, -90.0, 90.0);
   check("branch_max_diameter_ratio", branch_max_diameter_ratio, 0.1, 10.0);

@@ -400,6 +400,32 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_EQ(reasons["too low"], 1);
 }
 
+TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
+  // A central leader's scaffold leaving 62 deg above the horizontal (28 deg from the trunk):
+  // its points in the shell are a long directed cluster, and its axis is its own, not the
+  // horizontal.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.05, 2.0);  // trunk
+  const std::size_t trunk_points = pts.size();
+  const Eigen::Vector3d steep(std::cos(62.0 * M_PI / 180.0), 0.0, std::sin(62.0 * M_PI / 180.0));
+  addCylinder(pts, Eigen::Vector3d(0.05, 0, 0.7), steep, 0.022, 1.0);
+  std::vector<int> region(trunk_points);
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.002;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, config);
+  const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config);
+  ASSERT_EQ(branches.size(), 1u);
+  EXPECT_GT(branches[0].cylinder.axis.dot(steep), std::cos(5.0 * M_PI / 180.0));
+  EXPECT_NEAR(branches[0].cylinder.radius, 0.022, 0.004);
+  // With the steep bound at the radial one, the scaffold is forced towards the horizontal and
+  // either missed or measured off its axis.
+  config.branch_max_steep_angle = config.branch_max_radial_angle;
+  const auto bounded = modelBranches(pts, PointIndex(pts), trunk, region, config);
+  for (const auto& b : bounded)
+    EXPECT_LT(b.cylinder.axis.dot(steep), std::cos(10.0 * M_PI / 180.0));
+}
+
 TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   // Two primaries leave from one point 30 deg apart: near the trunk they are one cluster, so
   // the second is found only in what is left after the first is taken out.

@@ -89,6 +89,9 @@ struct ModelerConfig {
   /// unsplit are reported with "(search budget spent)"
   int branch_search_budget = 4000;
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
+  /// The same bound (deg) for a candidate whose points form a long, clearly directed cluster
+  /// (a steep scaffold of a central leader leaves more upwards than outwards).
+  double branch_max_steep_angle = 75.0;
   /// Branch axis seen along the trunk (elevation removed) vs the direction away from it, deg.
   double branch_max_azimuth = 20.0;
   double branch_min_elevation = -30.0;  ///< deg above the trunk's normal plane (primaries: >= -20)
