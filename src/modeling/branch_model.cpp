@@ -15,6 +15,8 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
+constexpr int SHORT_SPLIT =
+    12;  // candidates of this many times branch_min_points: split when short
 constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
@@ -314,7 +316,10 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       // spur, a shoot or what an extraction left of a branch; near the ground it is mixed
       // pixels between the trunk base and the soil.
       if (cyl->length < config.branch_min_length) {
-        reject("too short", false);
+        // A short fit to a large candidate ran across it (two branches meeting, a branch and
+        // its shoot): the halves may each hold a branch.
+        reject("too short",
+               static_cast<int>(cluster.size()) >= SHORT_SPLIT * config.branch_min_points);
         continue;
       }
       if (attachment.z() - base_z < config.branch_min_height) {
