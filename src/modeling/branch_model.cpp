@@ -15,8 +15,8 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
-constexpr int SHORT_SPLIT =
-    12;  // candidates of this many times branch_min_points: split when short
+// A candidate of this many times branch_min_points whose fit is too short is split and retried.
+constexpr int SHORT_SPLIT = 12;
 constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
