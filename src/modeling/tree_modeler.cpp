@@ -403,7 +403,6 @@ ModelResult TreeModeler::model(const Points& input) const {
   const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
 
   result.noise_sigma = trunk.noise_sigma;
-  result.trunk_slices = trunk.slices;
   watch.lap("trunk");
   const auto branches =
       modelBranches(pts, index, trunk, region, config_, &result.rejected_branches);

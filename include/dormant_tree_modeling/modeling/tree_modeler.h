@@ -43,7 +43,6 @@ struct ModelResult {
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
   std::vector<RejectedBranch> rejected_branches;        ///< candidates turned down, and why
   std::vector<TrunkCandidate> trunk_candidates;         ///< trunk bases tracked
-  std::vector<Slice> trunk_slices;                      ///< the trunk's slice circles, bottom up
 };
 
 /// @brief Algorithms 2 and 3 of the paper (docs/algorithms.md), plus the switchable additions of
