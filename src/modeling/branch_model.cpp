@@ -83,14 +83,27 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
 
 /// A thin horizontal line that continues straight through the trunk and out of its other
 /// side is a trellis wire (a branch ends at the trunk); preprocessing misses wires that run
-/// shorter than wire_min_length inside a tight crop.
+/// shorter than wire_min_length inside a tight crop. The wires of a row are parallel: when
+/// preprocessing found some, a piece crossing them is no wire (a branch and the one opposite
+/// it continue each other's line as well).
 bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const PointIndex& index,
-                   double sigma) {
+                   double sigma, const std::vector<Eigen::Vector3d>& wire_directions) {
   constexpr double MAX_WIRE_RADIUS = 0.004;
   constexpr double MAX_WIRE_TILT = 15.0 * DEG;
+  constexpr double MAX_WIRE_CROSSING = 15.0 * DEG;
   constexpr double STEP = 0.02;
   if (c.radius > MAX_WIRE_RADIUS || std::abs(c.axis.z()) > std::sin(MAX_WIRE_TILT))
     return false;
+  if (!wire_directions.empty()) {
+    const Eigen::Vector2d level = c.axis.head<2>().normalized();
+    bool parallel = false;
+    for (const auto& w : wire_directions) {
+      parallel =
+          parallel || std::abs(level.dot(w.head<2>().normalized())) >= std::cos(MAX_WIRE_CROSSING);
+    }
+    if (!parallel)
+      return false;
+  }
   // Walk the axis backwards through the trunk: sample the far side from 5 to 40 cm past the
   // trunk surface.
   Eigen::Vector3d through;
@@ -125,7 +138,8 @@ bool sameBranch(const BranchFit& a, const BranchFit& b) {
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,
-                                     std::vector<RejectedBranch>* rejected) {
+                                     std::vector<RejectedBranch>* rejected,
+                                     const std::vector<Eigen::Vector3d>& wire_directions) {
   std::vector<BranchFit> branches;
   if (trunk.cylinders.empty())
     return branches;
@@ -225,6 +239,39 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                           ? std::string(reason) + " (search budget spent)"
                                           : std::string(reason)));
       }
+    };
+    // Take a found line's points (a branch, a wire) out and look again at what remains of the
+    // cluster. Returns the points taken out.
+    auto searchRest = [&](const Cylinder& found) {
+      std::vector<int> taken;
+      const double reach = found.radius + 2.5 * std::max(sigma, scatter) + 0.005;
+      Points rest_pts;
+      std::vector<int> rest;
+      for (const int k : cluster) {
+        if (axisDistance(found, cand_pts[k]) > reach) {
+          rest.push_back(k);
+          rest_pts.push_back(cand_pts[k]);
+        } else {
+          taken.push_back(k);
+        }
+      }
+      if (static_cast<int>(rest.size()) >= 2 * config.branch_min_points) {
+        if (extractions < config.branch_search_budget) {
+          for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
+                                                    config.branch_min_points)) {
+            std::vector<int> mapped;
+            for (const int k : part)
+              mapped.push_back(rest[k]);
+            work.push_back(std::move(mapped));
+            ++extractions;
+          }
+        } else if (rejected) {
+          // Said, not silently dropped: what may hold another branch was not looked at.
+          rejected->push_back(
+              rejection(cand_pts, rest, "remainder not searched (search budget spent)"));
+        }
+      }
+      return taken;
     };
     if (static_cast<int>(sub.size()) < config.branch_min_points) {
       reject("too few points", false);
@@ -327,8 +374,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         continue;
       }
     }
-    if (config.ours_remove_clutter && looksLikeWire(*cyl, seg, index, sigma)) {
-      reject("a wire", false);
+    if (config.ours_remove_clutter && looksLikeWire(*cyl, seg, index, sigma, wire_directions)) {
+      // A wire passing close to a branch joins its cluster: the wire's points go, the rest is
+      // looked at again.
+      const std::vector<int> wire = searchRest(*cyl);
+      if (rejected && !wire.empty())
+        rejected->push_back(rejection(cand_pts, wire, "a wire"));
       continue;
     }
     Points in;
@@ -345,34 +396,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     fit.trunk_segment = segment;
     fit.attachment = attachment;
     branches.push_back(std::move(fit));
-    if (config.ours_constrain_ransac) {
-      // Take this branch's points out and look again at what remains of the cluster.
-      const double reach = cyl->radius + 2.5 * std::max(sigma, scatter) + 0.005;
-      Points rest_pts;
-      std::vector<int> rest;
-      for (const int k : cluster) {
-        if (axisDistance(*cyl, cand_pts[k]) > reach) {
-          rest.push_back(k);
-          rest_pts.push_back(cand_pts[k]);
-        }
-      }
-      if (static_cast<int>(rest.size()) >= 2 * config.branch_min_points) {
-        if (extractions < config.branch_search_budget) {
-          for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
-                                                    config.branch_min_points)) {
-            std::vector<int> mapped;
-            for (const int k : part)
-              mapped.push_back(rest[k]);
-            work.push_back(std::move(mapped));
-            ++extractions;
-          }
-        } else if (rejected) {
-          // Said, not silently dropped: what may hold another branch was not looked at.
-          rejected->push_back(
-              rejection(cand_pts, rest, "remainder not searched (search budget spent)"));
-        }
-      }
-    }
+    if (config.ours_constrain_ransac)
+      searchRest(*cyl);
   }
   if (config.ours_constrain_ransac) {
     // One branch split into two clusters (a gap in its returns) appears twice: keep the larger.

@@ -26,6 +26,7 @@ constexpr double WIRE_NEIGHBOURHOOD = 0.10;  // m, for the linearity test
 constexpr double WIRE_LINEARITY = 0.1;       // second / first eigenvalue below this: a line
 constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
+constexpr double WIRE_MAX_CROSSING = 10.0 * M_PI / 180.0;  // from the row's direction
 constexpr int MAX_WIRES = 10;
 constexpr double WIRE_TEST_VOXEL = 0.01;  // m
 
@@ -101,7 +102,8 @@ double longestRun(std::vector<double>& t) {
   return best;
 }
 
-std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
+std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
+                        std::vector<Eigen::Vector3d>* directions) {
   if (pts.size() < 100)
     return 0;
   // Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
@@ -129,9 +131,8 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
     if (linear[k])
       candidates.push_back(static_cast<int>(static_cast<std::size_t>(k) * stride));
   }
-  std::size_t removed = 0;
   Rng rng(seed);
-  std::vector<char> drop(pts.size(), 0);
+  std::vector<std::pair<Eigen::Vector3d, std::vector<int>>> found;  // direction, points
   for (int wire = 0; wire < MAX_WIRES && candidates.size() >= 10; ++wire) {
     const int n = static_cast<int>(candidates.size());
     Eigen::Vector3d best_o = Eigen::Vector3d::Zero(), best_d = Eigen::Vector3d::UnitX();
@@ -177,6 +178,35 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed) {
     candidates.swap(rest);
     if (longestRun(along) < min_length)
       continue;
+    // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
+    Points line;
+    for (const int i : inliers)
+      line.push_back(pts[i]);
+    found.push_back({principalAxis(line), std::move(inliers)});
+  }
+  // The wires of a row are parallel: the direction most of the lines found share is the row's,
+  // and a "wire" across it is a pair of opposite branches in line (thick ones return more
+  // points than a wire: the count alone does not tell).
+  const auto parallel = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::abs(a.dot(b)) >= std::cos(WIRE_MAX_CROSSING);
+  };
+  std::size_t strongest = 0, best_votes = 0;
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    std::size_t votes = 0;
+    for (const auto& other : found)
+      votes += parallel(found[k].first, other.first);
+    if (votes > best_votes ||
+        (votes == best_votes && found[k].second.size() > found[strongest].second.size())) {
+      best_votes = votes;
+      strongest = k;
+    }
+  }
+  std::size_t removed = 0;
+  std::vector<char> drop(pts.size(), 0);
+  for (const auto& [dir, inliers] : found) {
+    if (!parallel(dir, found[strongest].first))
+      continue;
+    directions->push_back(dir);
     for (const int i : inliers) {
       removed += !drop[i];
       drop[i] = 1;
@@ -368,7 +398,7 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
     s.floating = out.size() - kept.size();
     out.swap(kept);
     s.ground = removeGround(out, config.seed + 11);
-    s.wires = removeWires(out, config.wire_min_length, config.seed + 13);
+    s.wires = removeWires(out, config.wire_min_length, config.seed + 13, &s.wire_directions);
   }
   if (stats)
     *stats = s;

@@ -404,8 +404,8 @@ ModelResult TreeModeler::model(const Points& input) const {
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
-  const auto branches =
-      modelBranches(pts, index, trunk, region, config_, &result.rejected_branches);
+  const auto branches = modelBranches(pts, index, trunk, region, config_, &result.rejected_branches,
+                                      result.preprocess.wire_directions);
   watch.lap("branches");
 
   // Model, measurements and point classes.

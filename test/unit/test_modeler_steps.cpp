@@ -400,6 +400,41 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_EQ(reasons["too low"], 1);
 }
 
+TEST(BranchModel, OppositeThinBranchesAcrossTheRowAreNoWire) {
+  // Two thin level branches leave the trunk in opposite directions at one height: each
+  // continues the other's line through the trunk, as a wire would. The row's wires run along
+  // y; these run along x.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1.5}, 0.03, 1.5);
+  const std::size_t trunk_points = pts.size();
+  addCylinder(pts, {0.03, 0, 1.0}, {1, 0, 0}, 0.0035, 0.5);
+  addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.0035, 0.5);
+  addCylinder(pts, {0.045, -0.6, 1.3}, {0, 1, 0}, 0.0015, 1.2);  // a wire passing the trunk
+  std::vector<int> region(trunk_points);
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise_sigma = 0.002;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  const PointIndex index(pts);
+  const auto wires = [](const std::vector<RejectedBranch>& rejected) {
+    int n = 0;
+    for (const auto& r : rejected)
+      n += r.reason == "a wire";
+    return n;
+  };
+  std::vector<RejectedBranch> rejected;
+  const auto along_row = modelBranches(pts, index, trunk, region, config, &rejected, {{0, 1, 0}});
+  EXPECT_EQ(along_row.size(), 2u);
+  for (const auto& b : along_row)
+    EXPECT_GT(std::abs(b.cylinder.axis.x()), std::cos(5.0 * M_PI / 180));
+  EXPECT_EQ(wires(rejected), 2) << "the wire's two sides";
+
+  // Not knowing the row's direction, the pair looks like one more wire.
+  rejected.clear();
+  EXPECT_TRUE(modelBranches(pts, index, trunk, region, config, &rejected).empty());
+  EXPECT_EQ(wires(rejected), 4);
+}
+
 TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
   // A central leader's scaffold leaving 62 deg above the horizontal (28 deg from the trunk):
   // its points in the shell are a long directed cluster, and its axis is its own, not the

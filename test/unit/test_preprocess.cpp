@@ -1,4 +1,4 @@
-// Preprocessing: the voxel grid and the floating-pixel mask against brute force.
+// Preprocessing: the voxel grid and the floating-pixel mask against brute force; wires.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -105,6 +105,35 @@ TEST(VoxelDownsample, AGridTooFineForItsKeysIsAClearError) {
     EXPECT_EQ(e.code(), ErrorCode::INVALID_ARGUMENT);
     EXPECT_NE(std::string(e.what()).find("voxel_size"), std::string::npos);
   }
+}
+
+TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
+  // A trunk, and a noisy 2 m wire beside it, not quite along x: the wire goes, its direction
+  // is reported (the modeler takes short wire pieces as parallel to it), the trunk stays.
+  Rng rng(3);
+  Points pts;
+  for (int i = 0; i < 20000; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI);
+    pts.push_back(Eigen::Vector3d(0.05 * std::cos(a), 0.05 * std::sin(a), rng.uniform(0.1, 2.0)));
+  }
+  const Eigen::Vector3d along = Eigen::Vector3d(1.0, 0.2, 0.0).normalized();
+  const Eigen::Vector3d start(-1.0, -0.1, 1.2);  // passes the trunk's axis 10 cm off
+  for (int i = 0; i < 2000; ++i) {
+    pts.push_back(start + rng.uniform(0.0, 2.0) * along +
+                  Eigen::Vector3d(0.0, rng.normal(0.0, 0.004), rng.normal(0.0, 0.004)));
+  }
+  const ModelerConfig config;
+  PreprocessStats stats;
+  const Points out = preprocess(pts, config, &stats);
+  ASSERT_EQ(stats.wire_directions.size(), 1u);
+  EXPECT_GT(std::abs(stats.wire_directions[0].dot(along)), std::cos(1.0 * M_PI / 180.0));
+  EXPECT_GT(stats.wires, 0u);
+  const auto onTrunk = [](const Points& cloud) {
+    return std::count_if(cloud.begin(), cloud.end(),
+                         [](const Eigen::Vector3d& p) { return std::hypot(p.x(), p.y()) < 0.07; });
+  };
+  EXPECT_LT(out.size() - onTrunk(out), 20u) << "what is left of the wire";
+  EXPECT_GT(onTrunk(out), 0.95 * onTrunk(voxelDownsample(pts, config.voxel_size)));
 }
 
 }  // namespace

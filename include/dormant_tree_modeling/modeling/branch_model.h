@@ -45,10 +45,13 @@ bool sameBranch(const BranchFit& a, const BranchFit& b);
 /// crossing near the trunk do not), and duplicates of one branch are merged.
 /// @param index a PointIndex of `pts`
 /// @param rejected when given, receives every candidate turned down
+/// @param wire_directions the directions of the wires preprocessing removed (the row's): a
+/// short wire piece left in the cloud runs along them; empty: any direction
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,
-                                     std::vector<RejectedBranch>* rejected = nullptr);
+                                     std::vector<RejectedBranch>* rejected = nullptr,
+                                     const std::vector<Eigen::Vector3d>& wire_directions = {});
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

@@ -13,6 +13,7 @@ struct PreprocessStats {
   std::size_t floating = 0;  ///< isolated returns and mixed pixels (Eq. 1's targets)
   std::size_t ground = 0;
   std::size_t wires = 0;
+  std::vector<Eigen::Vector3d> wire_directions;  ///< unit, one per wire removed
   double floating_radius = 0.0;  ///< neighbourhood radius used for floating pixels (m)
 };
 
