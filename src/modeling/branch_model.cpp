@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "dormant_tree_modeling/modeling/branch_rays.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -17,7 +18,10 @@ constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
 // A candidate of this many times branch_min_points whose fit is too short is split and retried.
 constexpr int SHORT_SPLIT = 12;
-constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
+constexpr double STEEP_ELONGATION = 16.0;
+// A candidate parted along a ray is a branch along it: its fit stays within this of the ray.
+constexpr double RAY_AGREEMENT =
+    20.0 * DEG;  // variance ratio (4:1 in length) of a directed cluster
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
 // other's axis and the centres within DUPLICATE_REACH.
@@ -188,10 +192,33 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
   std::uint64_t stream = 0;
   // Work list: clusters, and what is left of a cluster after a branch was taken out of it (two
   // branches, or a branch and a shoot, close enough to form one cluster).
-  std::vector<std::vector<int>> work(clusters.rbegin(), clusters.rend());
+  struct Candidate {
+    std::vector<int> members;  // indices into cand_pts
+    bool along_ray = false;    // parted from a fused candidate along its strongest ray
+    Eigen::Vector3d ray = Eigen::Vector3d::Zero();  // that ray's direction
+  };
+  std::vector<Candidate> work;
+  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
+    work.push_back({*it, false, Eigen::Vector3d::Zero()});
   int extractions = 0;
+  // Parts of a cluster are clustered again: a part may have fallen apart.
+  auto pushParts = [&](const std::vector<int>& rest) {
+    Points rest_pts;
+    for (const int k : rest)
+      rest_pts.push_back(cand_pts[k]);
+    for (const auto& part :
+         euclideanClusters(rest_pts, config.branch_cluster_tolerance, config.branch_min_points)) {
+      std::vector<int> mapped;
+      for (const int k : part)
+        mapped.push_back(rest[k]);
+      work.push_back({std::move(mapped), false, Eigen::Vector3d::Zero()});
+      ++extractions;
+    }
+  };
   while (!work.empty()) {
-    const std::vector<int> cluster = std::move(work.back());
+    const std::vector<int> cluster = std::move(work.back().members);
+    const bool along_ray = work.back().along_ray;
+    const Eigen::Vector3d ray_direction = work.back().ray;
     work.pop_back();
     // The part of the branch near the trunk: where diameters are measured and pruning cuts.
     Points sub;
@@ -222,13 +249,31 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         Points cluster_pts;
         for (const int k : cluster)
           cluster_pts.push_back(cand_pts[k]);
+        // Branches leave the trunk as rays: the points along the strongest ray through the
+        // candidate are one candidate, the rest others. Once parted, halves by position.
+        if (config.branch_ray_split && sigma >= config.branch_ray_split_min_noise && !along_ray) {
+          const auto ray = strongestRay(cluster_pts, trunk.cylinders[segment],
+                                        config.branch_min_elevation, config.branch_max_steep_angle);
+          if (ray) {
+            const double tube = std::max(2.5 * sigma, 0.01) + 0.01;
+            std::vector<int> on, rest;
+            for (const int k : cluster)
+              (rayDistance(*ray, cand_pts[k]) < tube ? on : rest).push_back(k);
+            if (static_cast<int>(on.size()) >= config.branch_min_points && !rest.empty()) {
+              work.push_back({std::move(on), true, ray->direction});
+              ++extractions;
+              pushParts(rest);
+              return;
+            }
+          }
+        }
         const auto labels = kMeans(cluster_pts, 2, 20, config.seed * 7757ULL + stream++);
         std::vector<int> halves[2];
         for (std::size_t k = 0; k < cluster.size(); ++k)
           halves[labels[k]].push_back(cluster[k]);
         if (!halves[0].empty() && !halves[1].empty()) {
-          work.push_back(std::move(halves[0]));
-          work.push_back(std::move(halves[1]));
+          work.push_back({std::move(halves[0]), false, Eigen::Vector3d::Zero()});
+          work.push_back({std::move(halves[1]), false, Eigen::Vector3d::Zero()});
           extractions += 2;
           return;
         }
@@ -245,26 +290,17 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     auto searchRest = [&](const Cylinder& found) {
       std::vector<int> taken;
       const double reach = found.radius + 2.5 * std::max(sigma, scatter) + 0.005;
-      Points rest_pts;
       std::vector<int> rest;
       for (const int k : cluster) {
         if (axisDistance(found, cand_pts[k]) > reach) {
           rest.push_back(k);
-          rest_pts.push_back(cand_pts[k]);
         } else {
           taken.push_back(k);
         }
       }
       if (static_cast<int>(rest.size()) >= 2 * config.branch_min_points) {
         if (extractions < config.branch_search_budget) {
-          for (const auto& part : euclideanClusters(rest_pts, config.branch_cluster_tolerance,
-                                                    config.branch_min_points)) {
-            std::vector<int> mapped;
-            for (const int k : part)
-              mapped.push_back(rest[k]);
-            work.push_back(std::move(mapped));
-            ++extractions;
-          }
+          pushParts(rest);
         } else if (rejected) {
           // Said, not silently dropped: what may hold another branch was not looked at.
           rejected->push_back(
@@ -332,6 +368,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       const bool sideways =
           across.norm() > 0.3 && std::acos(std::clamp(across.normalized().dot(radial), -1.0, 1.0)) >
                                      config.branch_max_azimuth * DEG;
+      const bool off_ray = along_ray && std::acos(std::clamp(std::abs(cyl->axis.dot(ray_direction)),
+                                                             -1.0, 1.0)) > RAY_AGREEMENT;
+      if (off_ray) {
+        reject("off its ray", true);
+        continue;
+      }
       if (std::acos(std::clamp(cyl->axis.dot(radial), -1.0, 1.0)) > max_angle || sideways) {
         reject("not radial", true);
         continue;

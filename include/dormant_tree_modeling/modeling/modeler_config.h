@@ -88,6 +88,14 @@ struct ModelerConfig {
   /// needs hundreds (a mature tree lost a third of its branches at 400); candidates left
   /// unsplit are reported with "(search budget spent)"
   int branch_search_budget = 4000;
+  /// A candidate that fits no branch is first parted along the strongest ray from the trunk
+  /// axis through it (a Hough transform: the branches of a whorl fuse near the trunk at
+  /// centimetre noise), and only then halved by position.
+  bool branch_ray_split = true;
+  /// ... from this estimated range noise on (m): below it the whorl's branches stay apart, and
+  /// rays through the clutter of a cloud's few fused candidates pass as branches more often
+  /// than they part real ones (3 and 6 mm noise: F1 -0.1 to -0.5).
+  double branch_ray_split_min_noise = 0.008;
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
   /// The same bound (deg) for a candidate whose points form a long, clearly directed cluster
   /// (a steep scaffold of a central leader leaves more upwards than outwards).
