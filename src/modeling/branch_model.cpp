@@ -18,10 +18,9 @@ constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
 // A candidate of this many times branch_min_points whose fit is too short is split and retried.
 constexpr int SHORT_SPLIT = 12;
-constexpr double STEEP_ELONGATION = 16.0;
+constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // A candidate parted along a ray is a branch along it: its fit stays within this of the ray.
-constexpr double RAY_AGREEMENT =
-    20.0 * DEG;  // variance ratio (4:1 in length) of a directed cluster
+constexpr double RAY_AGREEMENT = 20.0 * DEG;
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
 // other's axis and the centres within DUPLICATE_REACH.

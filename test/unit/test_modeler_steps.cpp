@@ -33,6 +33,23 @@ void addCylinder(Points& pts, const Eigen::Vector3d& base, const Eigen::Vector3d
   }
 }
 
+/// The trunk of a built scene: its first trunk_points points, a vertical 3 cm cylinder from
+/// z 0 to 1.5 m, modeled at 2 mm noise.
+struct BuiltTrunk {
+  std::vector<int> region;
+  ModelerConfig config;
+  TrunkModel trunk;
+};
+
+BuiltTrunk buildTrunk(const Points& pts, std::size_t trunk_points) {
+  BuiltTrunk b;
+  b.region.resize(trunk_points);
+  std::iota(b.region.begin(), b.region.end(), 0);
+  b.config.noise_sigma = 0.002;
+  b.trunk = modelTrunk(pts, b.region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, b.config);
+  return b;
+}
+
 Cluster clusterOf(const Points& pts, int begin, int end) {
   Cluster c;
   c.members.resize(end - begin);
@@ -381,11 +398,7 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   addCylinder(pts, {0, 0.03, 0.15}, {0, 1, 0}, 0.01, 0.4);        // at the soil
   addCylinder(pts, {0.032, -0.6, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // a wire passing the trunk
   addCylinder(pts, {0.032, 0.05, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // and on past it
-  std::vector<int> region(trunk_points);
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise_sigma = 0.002;
-  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   std::vector<RejectedBranch> rejected;
   const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config, &rejected);
   ASSERT_EQ(branches.size(), 1u);
@@ -410,11 +423,7 @@ TEST(BranchModel, OppositeThinBranchesAcrossTheRowAreNoWire) {
   addCylinder(pts, {0.03, 0, 1.0}, {1, 0, 0}, 0.0035, 0.5);
   addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.0035, 0.5);
   addCylinder(pts, {0.045, -0.6, 1.3}, {0, 1, 0}, 0.0015, 1.2);  // a wire passing the trunk
-  std::vector<int> region(trunk_points);
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise_sigma = 0.002;
-  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   const PointIndex index(pts);
   const auto wires = [](const std::vector<RejectedBranch>& rejected) {
     int n = 0;
@@ -469,11 +478,7 @@ TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   const std::size_t trunk_points = pts.size();
   addCylinder(pts, {0.03, 0, 0.8}, {1, 0.27, 0.1}, 0.01, 0.5);
   addCylinder(pts, {0.03, 0, 0.8}, {1, -0.27, 0.1}, 0.01, 0.5);
-  std::vector<int> region(trunk_points);
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise_sigma = 0.002;
-  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, config);
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   const PointIndex index(pts);
   std::vector<RejectedBranch> rejected;
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 2u);

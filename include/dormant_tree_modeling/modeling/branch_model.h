@@ -24,9 +24,12 @@ struct BranchFit {
 struct RejectedBranch {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the candidate's points
   int points = 0;
-  std::string reason;  ///< "too few points", "no fit", "not radial", "misses the trunk",
-                       ///< "not at the surface", "too short", "too low", "duplicate"; with
-                       ///< " (search budget spent)" when it was not split for lack of budget
+  std::string reason;  ///< "too few points", "no fit", "off its ray", "not radial", "points
+                       ///< down", "thicker than the trunk", "misses the trunk", "not at the
+                       ///< surface", "too short", "too low", "a wire" (the wire's points),
+                       ///< "duplicate"; with " (search budget spent)" when it was not split
+                       ///< for lack of budget, and "remainder not searched (search budget
+                       ///< spent)" for what an extraction left
 };
 
 /// @brief Whether two detections are one branch (a gap in its returns split it into two
