@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_rays.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
@@ -21,6 +22,8 @@ constexpr int SHORT_SPLIT = 12;
 constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // A candidate parted along a ray is a branch along it: its fit stays within this of the ray.
 constexpr double RAY_AGREEMENT = 20.0 * DEG;
+// Detections needed before their median point count says what this tree's primaries return.
+constexpr std::size_t MIN_BRANCHES_FOR_MEDIAN = 4;
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
 // DUPLICATE_ATTACHMENT_GAP, or each centre within DUPLICATE_LINE_GAP (or their radii) of the
 // other's axis and the centres within DUPLICATE_REACH.
@@ -465,6 +468,28 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     for (std::size_t i = 0; i < branches.size(); ++i) {
       if (!drop[i])
         kept.push_back(std::move(branches[i]));
+    }
+    branches.swap(kept);
+  }
+  if (config.branch_min_relative_points > 0.0 && branches.size() >= MIN_BRANCHES_FOR_MEDIAN) {
+    // The primaries of one tree near its trunk return comparable numbers of points; a detection
+    // with a small fraction of the usual is a shoot on a primary, the tip of a neighbour's
+    // branch reaching in or a streak of mixed pixels.
+    std::vector<double> counts;
+    for (const auto& b : branches)
+      counts.push_back(static_cast<double>(b.inliers.size()));
+    const double floor = config.branch_min_relative_points * median(std::move(counts));
+    std::vector<BranchFit> kept;
+    for (auto& b : branches) {
+      if (static_cast<double>(b.inliers.size()) >= floor) {
+        kept.push_back(std::move(b));
+      } else if (rejected) {
+        RejectedBranch r;
+        r.centroid = b.cylinder.center;
+        r.points = static_cast<int>(b.inliers.size());
+        r.reason = "few points for this tree";
+        rejected->push_back(r);
+      }
     }
     branches.swap(kept);
   }

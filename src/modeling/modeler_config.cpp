@@ -70,6 +70,7 @@ const std::map<std::string, Setter>& setters() {
       {"trunk_taper_profile", setter(&C::trunk_taper_profile)},
       {"branch_ray_split", setter(&C::branch_ray_split)},
       {"branch_ray_split_min_noise", setter(&C::branch_ray_split_min_noise)},
+      {"branch_min_relative_points", setter(&C::branch_min_relative_points)},
       {"branch_cluster_tolerance", setter(&C::branch_cluster_tolerance)},
       {"branch_min_points", setter(&C::branch_min_points)},
       {"branch_fit_length", setter(&C::branch_fit_length)},
@@ -150,6 +151,7 @@ ModelerConfig ModelerConfig::paper() {
   c.trunk_max_bend = 0.0;
   c.trunk_taper_profile = false;
   c.branch_ray_split = false;
+  c.branch_min_relative_points = 0.0;
   return c;
 }
 
@@ -182,6 +184,7 @@ void ModelerConfig::validate() const {
   check("radius_continuity", radius_continuity, 0.01, 10.0);
   check("branch_search_budget", branch_search_budget, 0, 1000000);
   check("branch_ray_split_min_noise", branch_ray_split_min_noise, 0.0, 1.0);
+  check("branch_min_relative_points", branch_min_relative_points, 0.0, 1.0);
   check("branch_max_radial_angle", branch_max_radial_angle, 1.0, 90.0);
   check("branch_max_steep_angle", branch_max_steep_angle, branch_max_radial_angle, 90.0);
   check("branch_max_azimuth", branch_max_azimuth, 1.0, 180.0);

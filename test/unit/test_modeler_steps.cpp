@@ -494,6 +494,31 @@ TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   EXPECT_EQ(unsearched, 1) << "the lost branch is reported";
 }
 
+TEST(BranchModel, ADetectionWithFewPointsForItsTreeIsDropped) {
+  // Four primaries returning ~1100 points each within the fit length and a sparse line of ~220
+  // (a shoot, a neighbour's tip): below a quarter of the median, it goes.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
+  const std::size_t trunk_points = pts.size();
+  for (int k = 0; k < 4; ++k) {
+    const double a = k * M_PI / 2.0;
+    addCylinder(pts, {0.03 * std::cos(a), 0.03 * std::sin(a), 0.6 + 0.2 * k},
+                {std::cos(a), std::sin(a), 0.15}, 0.01, 0.5, 0.004);
+  }
+  addCylinder(pts, {0.03 * std::cos(0.8), 0.03 * std::sin(0.8), 1.3},
+              {std::cos(0.8), std::sin(0.8), 0}, 0.006, 0.5, 0.011);
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
+  const PointIndex index(pts);
+  std::vector<RejectedBranch> rejected;
+  EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 4u);
+  int dropped = 0;
+  for (const auto& r : rejected)
+    dropped += r.reason == "few points for this tree";
+  EXPECT_EQ(dropped, 1);
+  config.branch_min_relative_points = 0.0;
+  EXPECT_EQ(modelBranches(pts, index, trunk, region, config).size(), 5u);
+}
+
 TEST(BranchModel, PiecesOfOneSteepBranchAreOneBranch) {
   const auto fit = [](const Eigen::Vector3d& centre, const Eigen::Vector3d& axis, double radius,
                       const Eigen::Vector3d& attachment) {

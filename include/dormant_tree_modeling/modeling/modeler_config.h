@@ -96,6 +96,10 @@ struct ModelerConfig {
   /// rays through the clutter of a cloud's few fused candidates pass as branches more often
   /// than they part real ones (3 and 6 mm noise: F1 -0.1 to -0.5).
   double branch_ray_split_min_noise = 0.008;
+  /// A detection with fewer inliers than this fraction of the median over the tree's
+  /// detections is dropped (a shoot on a primary, a neighbour's branch tip, a streak of mixed
+  /// pixels); 0: off. Needs at least 4 detections.
+  double branch_min_relative_points = 0.25;
   double branch_max_radial_angle = 60.0;  ///< branch axis vs the direction away from the trunk
   /// The same bound (deg) for a candidate whose points form a long, clearly directed cluster
   /// (a steep scaffold of a central leader leaves more upwards than outwards).
