@@ -22,6 +22,10 @@ constexpr int SHORT_SPLIT = 12;
 constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
 // A candidate parted along a ray is a branch along it: its fit stays within this of the ray.
 constexpr double RAY_AGREEMENT = 20.0 * DEG;
+// Its points: within the noise band (2.5 sigma, at least RAY_MIN_BAND) plus RAY_TUBE_RADIUS (a
+// thin branch's radius with a margin) of the ray.
+constexpr double RAY_MIN_BAND = 0.01;     // m
+constexpr double RAY_TUBE_RADIUS = 0.01;  // m
 // Detections needed before their median point count says what this tree's primaries return.
 constexpr std::size_t MIN_BRANCHES_FOR_MEDIAN = 4;
 // Two detections of one branch: axes within DUPLICATE_MAX_ANGLE and attachments closer than
@@ -257,7 +261,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
           const auto ray = strongestRay(cluster_pts, trunk.cylinders[segment],
                                         config.branch_min_elevation, config.branch_max_steep_angle);
           if (ray) {
-            const double tube = std::max(2.5 * sigma, 0.01) + 0.01;
+            const double tube = std::max(2.5 * sigma, RAY_MIN_BAND) + RAY_TUBE_RADIUS;
             std::vector<int> on, rest;
             for (const int k : cluster)
               (rayDistance(*ray, cand_pts[k]) < tube ? on : rest).push_back(k);
