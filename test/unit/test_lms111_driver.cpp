@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -102,6 +103,7 @@ TEST(Lms111Driver, StreamsTheRequestedScansInBothProtocols) {
     EXPECT_EQ(st.scan_gaps, 0u);
     EXPECT_NE(st.device_ident.find("LMS111"), std::string::npos);
     std::lock_guard<std::mutex> lock(sink.mutex);
+    std::size_t on_period = 0;
     for (std::size_t i = 0; i < sink.scans.size(); ++i) {
       const ScanTelegram& t = sink.scans[i].telegram;
       ASSERT_NE(t.channel("DIST1"), nullptr);
@@ -110,12 +112,16 @@ TEST(Lms111Driver, StreamsTheRequestedScansInBothProtocols) {
       EXPECT_NE(t.channel("RSSI1"), nullptr);
       if (i > 0) {
         // Stamps 20 ms apart from the device clock; only the lower envelope of the transfer
-        // delays, settling over the first scans, moves them.
-        EXPECT_NEAR(sink.scans[i].stamp_s - sink.scans[i - 1].stamp_s, 0.02, 1e-3);
+        // delays moves them, and only earlier: when a scan arrives faster than every one
+        // before it (on a loaded machine the first scans' delays vary by milliseconds).
+        const double step = sink.scans[i].stamp_s - sink.scans[i - 1].stamp_s;
+        EXPECT_LE(step, 0.02 + 1e-3);
+        on_period += std::abs(step - 0.02) <= 1e-3;
         EXPECT_LE(sink.scans[i].stamp_s, sink.scans[i].received_s);
         EXPECT_GT(sink.scans[i].stamp_s, sink.scans[i].received_s - 0.05);
       }
     }
+    EXPECT_GE(on_period, (sink.scans.size() - 1) * 3 / 4) << protocolName(p);
   }
 }
 
