@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "dormant_tree_modeling/common/statistics.h"
@@ -129,6 +130,24 @@ bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const Point
   return samples > 0 && occupied >= 0.8 * samples;
 }
 
+/// Keeps the fits not marked in drop; the others are reported as turned down for reason.
+void removeMarked(std::vector<BranchFit>& branches, const std::vector<char>& drop,
+                  const char* reason, std::vector<RejectedBranch>* rejected) {
+  std::vector<BranchFit> kept;
+  for (std::size_t i = 0; i < branches.size(); ++i) {
+    if (!drop[i]) {
+      kept.push_back(std::move(branches[i]));
+    } else if (rejected) {
+      RejectedBranch r;
+      r.centroid = branches[i].cylinder.center;
+      r.points = static_cast<int>(branches[i].inliers.size());
+      r.reason = reason;
+      rejected->push_back(r);
+    }
+  }
+  branches.swap(kept);
+}
+
 }  // namespace
 
 bool sameBranch(const BranchFit& a, const BranchFit& b) {
@@ -200,12 +219,12 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
   // branches, or a branch and a shoot, close enough to form one cluster).
   struct Candidate {
     std::vector<int> members;  // indices into cand_pts
-    bool along_ray = false;    // parted from a fused candidate along its strongest ray
-    Eigen::Vector3d ray = Eigen::Vector3d::Zero();  // that ray's direction
+    // Set when parted from a fused candidate along its strongest ray: that ray's direction.
+    std::optional<Eigen::Vector3d> ray;
   };
   std::vector<Candidate> work;
   for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
-    work.push_back({*it, false, Eigen::Vector3d::Zero()});
+    work.push_back({*it, std::nullopt});
   int extractions = 0;
   // Parts of a cluster are clustered again: a part may have fallen apart.
   auto pushParts = [&](const std::vector<int>& rest) {
@@ -217,14 +236,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       std::vector<int> mapped;
       for (const int k : part)
         mapped.push_back(rest[k]);
-      work.push_back({std::move(mapped), false, Eigen::Vector3d::Zero()});
+      work.push_back({std::move(mapped), std::nullopt});
       ++extractions;
     }
   };
   while (!work.empty()) {
     const std::vector<int> cluster = std::move(work.back().members);
-    const bool along_ray = work.back().along_ray;
-    const Eigen::Vector3d ray_direction = work.back().ray;
+    const std::optional<Eigen::Vector3d> along_ray = work.back().ray;
     work.pop_back();
     // The part of the branch near the trunk: where diameters are measured and pruning cuts.
     Points sub;
@@ -266,7 +284,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
             for (const int k : cluster)
               (rayDistance(*ray, cand_pts[k]) < tube ? on : rest).push_back(k);
             if (static_cast<int>(on.size()) >= config.branch_min_points && !rest.empty()) {
-              work.push_back({std::move(on), true, ray->direction});
+              work.push_back({std::move(on), ray->direction});
               ++extractions;
               pushParts(rest);
               return;
@@ -278,8 +296,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         for (std::size_t k = 0; k < cluster.size(); ++k)
           halves[labels[k]].push_back(cluster[k]);
         if (!halves[0].empty() && !halves[1].empty()) {
-          work.push_back({std::move(halves[0]), false, Eigen::Vector3d::Zero()});
-          work.push_back({std::move(halves[1]), false, Eigen::Vector3d::Zero()});
+          work.push_back({std::move(halves[0]), std::nullopt});
+          work.push_back({std::move(halves[1]), std::nullopt});
           extractions += 2;
           return;
         }
@@ -374,7 +392,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       const bool sideways =
           across.norm() > 0.3 && std::acos(std::clamp(across.normalized().dot(radial), -1.0, 1.0)) >
                                      config.branch_max_azimuth * DEG;
-      const bool off_ray = along_ray && std::acos(std::clamp(std::abs(cyl->axis.dot(ray_direction)),
+      const bool off_ray = along_ray && std::acos(std::clamp(std::abs(cyl->axis.dot(*along_ray)),
                                                              -1.0, 1.0)) > RAY_AGREEMENT;
       if (off_ray) {
         reject("off its ray", true);
@@ -454,26 +472,11 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
         if (drop[i] || drop[k])
           continue;
-        if (sameBranch(branches[i], branches[k])) {
-          const std::size_t loser =
-              branches[i].inliers.size() >= branches[k].inliers.size() ? k : i;
-          drop[loser] = 1;
-          if (rejected) {
-            RejectedBranch r;
-            r.centroid = branches[loser].cylinder.center;
-            r.points = static_cast<int>(branches[loser].inliers.size());
-            r.reason = "duplicate";
-            rejected->push_back(r);
-          }
-        }
+        if (sameBranch(branches[i], branches[k]))
+          drop[branches[i].inliers.size() >= branches[k].inliers.size() ? k : i] = 1;
       }
     }
-    std::vector<BranchFit> kept;
-    for (std::size_t i = 0; i < branches.size(); ++i) {
-      if (!drop[i])
-        kept.push_back(std::move(branches[i]));
-    }
-    branches.swap(kept);
+    removeMarked(branches, drop, "duplicate", rejected);
   }
   if (config.branch_min_relative_points > 0.0 && branches.size() >= MIN_BRANCHES_FOR_MEDIAN) {
     // The primaries of one tree near its trunk return comparable numbers of points; a detection
@@ -483,19 +486,10 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     for (const auto& b : branches)
       counts.push_back(static_cast<double>(b.inliers.size()));
     const double floor = config.branch_min_relative_points * median(std::move(counts));
-    std::vector<BranchFit> kept;
-    for (auto& b : branches) {
-      if (static_cast<double>(b.inliers.size()) >= floor) {
-        kept.push_back(std::move(b));
-      } else if (rejected) {
-        RejectedBranch r;
-        r.centroid = b.cylinder.center;
-        r.points = static_cast<int>(b.inliers.size());
-        r.reason = "few points for this tree";
-        rejected->push_back(r);
-      }
-    }
-    branches.swap(kept);
+    std::vector<char> drop(branches.size(), 0);
+    for (std::size_t i = 0; i < branches.size(); ++i)
+      drop[i] = static_cast<double>(branches[i].inliers.size()) < floor;
+    removeMarked(branches, drop, "few points for this tree", rejected);
   }
   return branches;
 }
