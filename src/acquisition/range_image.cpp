@@ -20,6 +20,19 @@ double RangeImage::theta(int row) const {
   return theta0 + row * theta_step;
 }
 
+std::optional<double> RangeImage::middleStamp() const {
+  const int n = static_cast<int>(row_stamp.size());
+  const int mid = n / 2;
+  // Outwards from the middle, the earlier row first at each distance.
+  for (int d = 0; d <= mid; ++d) {
+    for (const int i : {mid - d, mid + d}) {
+      if (i >= 0 && i < n && row_stamp[i] > 0.0)
+        return row_stamp[i];
+    }
+  }
+  return std::nullopt;
+}
+
 double RangeImage::theta(int row, int col) const {
   const double rate =
       static_cast<std::size_t>(row) < row_theta_rate.size() ? row_theta_rate[row] : 0.0;

@@ -1,7 +1,9 @@
 #include "dormant_tree_modeling/acquisition/sequencer.h"
 
 #include <chrono>
+#include <regex>
 #include <sstream>
+#include <stdexcept>
 
 #include "dormant_tree_modeling/common/error.h"
 
@@ -94,6 +96,18 @@ std::string outcomesMarkdown(const std::vector<ViewOutcome>& outcomes, int plann
         << o.seconds << " | " << o.message << " |\n";
   }
   return out.str();
+}
+
+std::optional<int> viewsAcquired(const std::string& message) {
+  static const std::regex FORM(R"(^finished: (\d+) of \d+ planned views acquired)");
+  std::smatch m;
+  if (!std::regex_search(message, m, FORM))
+    return std::nullopt;
+  try {
+    return std::stoi(m[1].str());
+  } catch (const std::out_of_range&) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace acquisition

@@ -17,6 +17,13 @@
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
+namespace {
+
+// Rate of the platform pose on /tf: a lookup at a view's time waits at most one period.
+constexpr double PLATFORM_TF_HZ = 20.0;
+
+}  // namespace
+
 AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string plan_file = pnh.param<std::string>("plan_file", "");
   if (!plan_file.empty())
@@ -66,10 +73,23 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   diagnostics_.add("acquisition", this, &AcquisitionNode::diagnose);
   diagnostics_timer_ =
       nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  platform_tf_timer_ = nh.createTimer(ros::Duration(1.0 / PLATFORM_TF_HZ),
+                                      [this](const ros::TimerEvent&) { republishPlatform(); });
   if (pnh.param("autostart", false)) {
     running_ = true;
     worker_ = std::thread([this] { run(); });
   }
+}
+
+void AcquisitionNode::republishPlatform() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!platform_tf_)
+    return;
+  const ros::Time now = ros::Time::now();
+  if (now <= platform_tf_->header.stamp)
+    return;  // tf refuses a repeated stamp
+  platform_tf_->header.stamp = now;
+  platform_tf_pub_.sendTransform(*platform_tf_);
 }
 
 AcquisitionNode::~AcquisitionNode() {
@@ -160,7 +180,8 @@ bool AcquisitionNode::askForPlatform(const acquisition::PlannedView& view) {
   tf.header.stamp = ros::Time::now();
   tf.header.frame_id = orchard_frame_;
   tf.child_frame_id = platform_frame_;
-  static_tf_.sendTransform(tf);
+  platform_tf_ = tf;
+  platform_tf_pub_.sendTransform(tf);
   publish(prompt_pub_, "platform at position " + std::to_string(view.platform_index + 1));
   return true;
 }

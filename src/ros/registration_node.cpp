@@ -9,9 +9,11 @@
 #include <iomanip>
 #include <sstream>
 
+#include "dormant_tree_modeling/acquisition/sequencer.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -47,19 +49,22 @@ bool samePlace(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 }  // namespace
 
 RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : config_(loadConfig(pnh)) {
+    : config_(loadConfig(pnh)), nh_(nh) {
   orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
   tree_frame_ = pnh.param<std::string>("tree_frame", "tree");
   laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
   output_dir_ = pnh.param<std::string>("output_dir", defaultOutputDir());
   expected_views_ = pnh.param<int>("expected_views", 0);
   hint_timeout_ = pnh.param<double>("hint_timeout", 0.5);
+  finished_wait_ = pnh.param<double>("finished_wait", 10.0);
   if (expected_views_ < 0)
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "~expected_views must be >= 0 (0: no automatic "
                 "registration by count)");
-  if (hint_timeout_ < 0)
+  if (!(hint_timeout_ >= 0))
     throw Error(ErrorCode::INVALID_ARGUMENT, "~hint_timeout must be >= 0 s");
+  if (!(finished_wait_ >= 0))
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~finished_wait must be >= 0 s");
   if (tree_frame_.empty() || orchard_frame_.empty() || tree_frame_ == orchard_frame_)
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "~tree_frame and ~orchard_frame must be two different, non-empty frame names");
@@ -107,17 +112,16 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
   v.sensor = Eigen::Vector3d::Zero();  // the frame's origin: close enough to tell the side
   if (tf_buffer_._frameExists(laser_frame_)) {
     try {
-      v.sensor = tf2::transformToEigen(tf_buffer_.lookupTransform(msg->header.frame_id,
-                                                                  laser_frame_, msg->header.stamp,
-                                                                  ros::Duration(hint_timeout_)))
+      v.sensor = tf2::transformToEigen(lookupWithin(tf_buffer_, msg->header.frame_id, laser_frame_,
+                                                    msg->header.stamp, hint_timeout_))
                      .translation();
     } catch (const tf2::TransformException&) {
     }
   }
   std::optional<Eigen::Isometry3d> hint;
   try {
-    hint = tf2::transformToEigen(tf_buffer_.lookupTransform(
-        orchard_frame_, msg->header.frame_id, msg->header.stamp, ros::Duration(hint_timeout_)));
+    hint = tf2::transformToEigen(lookupWithin(tf_buffer_, orchard_frame_, msg->header.frame_id,
+                                              msg->header.stamp, hint_timeout_));
   } catch (const tf2::TransformException&) {
   }
   bool start = false;
@@ -135,7 +139,9 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
              views_.back().points.size(),
              dropped ? (", " + std::to_string(dropped) + " non-finite dropped").c_str() : "",
              views_.back().station, hint ? "" : " (no platform hint)");
-    start = expected_views_ > 0 && static_cast<int>(views_.size()) >= expected_views_;
+    const int have = static_cast<int>(views_.size());
+    start = (expected_views_ > 0 && have >= expected_views_) ||
+            (awaited_views_ && have >= *awaited_views_);
   }
   if (start) {
     std::string why;
@@ -147,6 +153,36 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
 void RegistrationNode::progressCallback(const std_msgs::StringConstPtr& msg) {
   if (msg->data.rfind("finished", 0) != 0)
     return;
+  const std::optional<int> named = acquisition::viewsAcquired(msg->data);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const int have = static_cast<int>(views_.size());
+    if (named && have < *named && finished_wait_ > 0 && !busy_) {
+      // A replayed plan ends while its last sweeps are still being assembled.
+      awaited_views_ = *named;
+      ROS_INFO(
+          "registration: the plan finished with %d views, %d here; waiting up to %.1f s for "
+          "the rest",
+          *named, have, finished_wait_);
+      finished_timer_ = nh_.createWallTimer(
+          ros::WallDuration(finished_wait_),
+          [this](const ros::WallTimerEvent&) { finishedWaitExpired(); }, true);
+      return;
+    }
+  }
+  std::string why;
+  if (!startRegistration(why))
+    ROS_WARN("registration: the plan finished, but %s", why.c_str());
+}
+
+void RegistrationNode::finishedWaitExpired() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!awaited_views_)
+      return;  // they arrived in time
+    ROS_WARN("registration: the plan finished with %d views, only %zu arrived within %.1f s",
+             *awaited_views_, views_.size(), finished_wait_);
+  }
   std::string why;
   if (!startRegistration(why))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
@@ -165,6 +201,7 @@ bool RegistrationNode::resetService(std_srvs::Trigger::Request&, std_srvs::Trigg
   res.message = "dropped " + std::to_string(views_.size()) + " views";
   views_.clear();
   last_hint_.reset();
+  awaited_views_.reset();
   res.success = true;
   return true;
 }
@@ -185,6 +222,7 @@ bool RegistrationNode::startRegistration(std::string& why) {
     // The views go to the worker; new ones start the next tree.
     views.swap(views_);
     last_hint_.reset();
+    awaited_views_.reset();
     stamp = last_stamp_;
     busy_ = true;
   }

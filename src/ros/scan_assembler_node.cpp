@@ -6,6 +6,7 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -20,11 +22,17 @@ namespace ros_layer {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
+constexpr int PASSIVE_QUEUE = 3000;
+// Wall-clock wait for the stage's transform at a view's time.
+constexpr double TF_WAIT_S = 1.0;
+// Passive mode: how often the wait for a sweep's last lines checks for shutdown, and after how
+// long it says it is still waiting.
+constexpr double LINE_POLL_S = 0.5;
+constexpr double LINE_WAIT_WARN_S = 10.0;
 
 }  // namespace
 
-ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : nh_(nh), tf_listener_(tf_buffer_) {
+ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::string mode = pnh.param<std::string>("mode", "continuous");
   if (mode != "continuous" && mode != "step")
     throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode);
@@ -63,8 +71,12 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     worker_ = std::thread([this] { passiveLoop(); });
   }
 
-  scan_sub_ = nh.subscribe("scan", 200, &ScanAssemblerNode::scanCallback, this);
-  joint_sub_ = nh.subscribe("joint_states", 500, &ScanAssemblerNode::jointCallback, this);
+  // A bag player that falls behind catches up in bursts: a replay must not drop scans or
+  // positions (at 50 Hz, a minute of each).
+  const int queue = passive_ ? PASSIVE_QUEUE : 200;
+  scan_sub_ = nh.subscribe("scan", queue, &ScanAssemblerNode::scanCallback, this);
+  joint_sub_ =
+      nh.subscribe("joint_states", std::max(queue, 500), &ScanAssemblerNode::jointCallback, this);
   cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 2, true);
   image_pub_ = nh.advertise<sensor_msgs::Image>("range_image", 2, true);
   if (!passive_)
@@ -130,8 +142,11 @@ void ScanAssemblerNode::passiveLoop() {
     }
     const ros::WallTime started = ros::WallTime::now();
     try {
-      // A line stamped after the sweep's end shows that all of its lines have arrived.
-      recorder_->firstLineAfter(sweep.end, 3.0);
+      // A line stamped after the sweep's end shows that all of its lines have arrived. In a
+      // replay it comes, however long the player stalls: assembling before it would make a
+      // view that differs from the live one.
+      if (!awaitLineAfter(sweep.end))
+        return;
       std::size_t dropped = 0, missing = 0;
       const acquisition::RangeImage image = acquisition::assembleRangeImage(
           recorder_->linesBetween(sweep.begin, sweep.end), recorder_->history(),
@@ -148,6 +163,26 @@ void ScanAssemblerNode::passiveLoop() {
       noteOutcome(false, e.what());
     }
   }
+}
+
+bool ScanAssemblerNode::awaitLineAfter(double stamp) {
+  const ros::WallTime since = ros::WallTime::now();
+  ros::WallTime warned = since;
+  while (!recorder_->firstLineAfter(stamp, LINE_POLL_S)) {
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      if (stop_)
+        return false;
+    }
+    if ((ros::WallTime::now() - warned).toSec() > LINE_WAIT_WARN_S) {
+      warned = ros::WallTime::now();
+      ROS_WARN(
+          "scan_assembler: a sweep ended at %.3f; no later scan line on %s for %.0f s (is "
+          "the bag still playing?)",
+          stamp, scan_sub_.getTopic().c_str(), (warned - since).toSec());
+    }
+  }
+  return true;
 }
 
 void ScanAssemblerNode::noteOutcome(bool ok, const std::string& message) {
@@ -216,9 +251,14 @@ std::string ScanAssemblerNode::acquire() {
 Eigen::Vector3d ScanAssemblerNode::treeHint(const ros::Time& stamp) {
   // Where the plan (the acquisition's orchard -> platform) puts the tree: its frame's origin,
   // the base of the trunk on the ground.
-  if (!tree_frame_.empty() && tf_buffer_.canTransform(platform_frame_, tree_frame_, stamp)) {
-    const auto t = tf_buffer_.lookupTransform(platform_frame_, tree_frame_, stamp).transform;
-    return Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  if (!tree_frame_.empty() && tf_buffer_._frameExists(tree_frame_)) {
+    try {
+      const auto t =
+          lookupWithin(tf_buffer_, platform_frame_, tree_frame_, stamp, TF_WAIT_S).transform;
+      return Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(10.0, "scan_assembler: %s", e.what());
+    }
   }
   ROS_WARN_ONCE("scan_assembler: no transform %s <- %s: the tree is assumed %.2f m straight ahead",
                 platform_frame_.c_str(), tree_frame_.c_str(), tree_distance_);
@@ -233,11 +273,14 @@ std::string ScanAssemblerNode::publishView(acquisition::RangeImage image, std::s
                                            std::to_string(image.rows) +
                                            " scan lines missing (did the laser drop out?)");
   }
-  const auto stamp = ros::Time(image.row_stamp[image.rows / 2]);
+  const std::optional<double> middle = image.middleStamp();
+  if (!middle)
+    throw Error(ErrorCode::EMPTY_INPUT, "no row of the range image has a scan line");
+  const auto stamp = ros::Time(*middle);
   Eigen::Isometry3d stage_in_platform;
   try {
     stage_in_platform = tf2::transformToEigen(
-        tf_buffer_.lookupTransform(platform_frame_, stage_frame_, stamp, ros::Duration(1.0)));
+        lookupWithin(tf_buffer_, platform_frame_, stage_frame_, stamp, TF_WAIT_S));
   } catch (const tf2::TransformException& e) {
     throw Error(ErrorCode::IO_FAILURE, std::string("no transform ") + platform_frame_ + " <- " +
                                            stage_frame_ + ": " + e.what());

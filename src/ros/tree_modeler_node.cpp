@@ -17,6 +17,7 @@
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/ros/model_messages.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -192,14 +193,9 @@ void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const Cloud& 
   modeling::TreeModel out = model;
   Eigen::Isometry3d to_output = Eigen::Isometry3d::Identity();
   if (!output_frame_.empty() && output_frame_ != header.frame_id) {
-    // Waits in wall time: in a replay the bag may have ended and sim time stopped.
-    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(2.0);
-    while (!tf_buffer_.canTransform(output_frame_, header.frame_id, header.stamp) &&
-           ros::WallTime::now() < give_up)
-      ros::WallDuration(0.02).sleep();
     try {
       to_output = tf2::transformToEigen(
-          tf_buffer_.lookupTransform(output_frame_, header.frame_id, header.stamp));
+          lookupWithin(tf_buffer_, output_frame_, header.frame_id, header.stamp, 2.0));
       out = modeling::transformModel(model, to_output);
     } catch (const tf2::TransformException& e) {
       throw Error(ErrorCode::IO_FAILURE, "the model was published but not written: no transform " +

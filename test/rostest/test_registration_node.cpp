@@ -13,6 +13,9 @@
 #include <pcl/point_types.h>
 
 #include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
 
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/conversions.h"
@@ -30,32 +33,33 @@ bool callTrigger(const std::string& service, std::string& message) {
   return t.response.success;
 }
 
-TEST(RegistrationNode, RegistersTheViewsOfTwoPlatformPositionsPerSide) {
-  ros::NodeHandle nh;
-  std::string message;
-  EXPECT_FALSE(callTrigger("/registration/register", message)) << "nothing collected yet";
-  EXPECT_NE(message.find("no views"), std::string::npos) << message;
+// Four platform positions (two per side), two slide positions each, guesses 0.5 m / 20 deg
+// off: the views as the scan assembler would publish them. Built once.
+const registration::ViewFolder& dataset() {
+  static const registration::ViewFolder folder = [] {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("dtm_registration_rostest_" + std::to_string(getpid()));
+    simulation::DatasetOptions o;
+    o.seed = 5;
+    o.sensor.range_noise_sigma = 0.006;
+    o.plan.heights = {1.5};
+    o.plan.slide_steps = 2;
+    o.plan.slide_step = 0.2;
+    simulation::writeDataset(o, dir.string());
+    registration::ViewFolder f = registration::readViewFolder(dir.string());
+    std::filesystem::remove_all(dir);
+    return f;
+  }();
+  return folder;
+}
 
-  // Four platform positions (two per side), two slide positions each, guesses 0.5 m / 20 deg
-  // off: the views as the scan assembler would publish them.
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("dtm_registration_rostest_" + std::to_string(getpid()));
-  simulation::DatasetOptions o;
-  o.seed = 5;
-  o.sensor.range_noise_sigma = 0.006;
-  o.plan.heights = {1.5};
-  o.plan.slide_steps = 2;
-  o.plan.slide_step = 0.2;
-  simulation::writeDataset(o, dir.string());
-  const registration::ViewFolder folder = registration::readViewFolder(dir.string());
-  std::filesystem::remove_all(dir);
-  ASSERT_EQ(folder.views.size(), 8u);
-
-  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 10);
-  tf2_ros::StaticTransformBroadcaster hints;
-  ros::Duration(1.0).sleep();  // the node connects
-  int station = -1;
-  for (const auto& v : folder.views) {
+/// Publishes views [first, last) of the dataset, each platform position's hint on tf first.
+void publishViews(ros::Publisher& pub, tf2_ros::StaticTransformBroadcaster& hints,
+                  std::size_t first, std::size_t last) {
+  const auto& folder = dataset();
+  int station = first > 0 ? folder.views[first - 1].station : -1;
+  for (std::size_t i = first; i < last; ++i) {
+    const auto& v = folder.views[i];
     if (v.station != station) {
       // The operator moved the platform: a new hint.
       station = v.station;
@@ -74,6 +78,21 @@ TEST(RegistrationNode, RegistersTheViewsOfTwoPlatformPositionsPerSide) {
     pub.publish(ros_layer::toMsg(cloud, "platform", ros::Time::now()));
     ros::Duration(0.3).sleep();
   }
+}
+
+TEST(RegistrationNode, RegistersTheViewsOfTwoPlatformPositionsPerSide) {
+  ros::NodeHandle nh;
+  std::string message;
+  EXPECT_FALSE(callTrigger("/registration/register", message)) << "nothing collected yet";
+  EXPECT_NE(message.find("no views"), std::string::npos) << message;
+
+  const registration::ViewFolder& folder = dataset();
+  ASSERT_EQ(folder.views.size(), 8u);
+
+  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 10);
+  tf2_ros::StaticTransformBroadcaster hints;
+  ros::Duration(1.0).sleep();  // the node connects
+  publishViews(pub, hints, 0, folder.views.size());
   ros::Duration(1.0).sleep();
   EXPECT_TRUE(callTrigger("/registration/register", message)) << message;
 
@@ -128,6 +147,43 @@ TEST(RegistrationNode, RegistersTheViewsOfTwoPlatformPositionsPerSide) {
 
   // The views went to that registration: a new tree starts empty.
   EXPECT_FALSE(callTrigger("/registration/register", message));
+}
+
+TEST(RegistrationNode, WaitsForTheViewsThePlansEndNames) {
+  // A replay: the plan's end arrives while the last sweep is still being assembled.
+  ros::NodeHandle nh;
+  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 10);
+  ros::Publisher progress = nh.advertise<std_msgs::String>("/acquisition/progress", 10);
+  tf2_ros::StaticTransformBroadcaster hints;
+  // The report is latched: the first test's comes first, this test's after it.
+  std::mutex mutex;
+  std::vector<std::string> reports;
+  ros::Subscriber sub = nh.subscribe<std_msgs::String>("/registration/report", 5,
+                                                       [&](const std_msgs::StringConstPtr& m) {
+                                                         std::lock_guard<std::mutex> lock(mutex);
+                                                         reports.push_back(m->data);
+                                                       });
+  ros::Duration(1.0).sleep();
+  std::size_t before = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    before = reports.size();
+  }
+  publishViews(pub, hints, 0, 7);
+  std_msgs::String finished;
+  finished.data = "finished: 8 of 8 planned views acquired, 40 s of scanning.";
+  progress.publish(finished);
+  ros::Duration(1.0).sleep();
+  publishViews(pub, hints, 7, 8);
+  std::string report;
+  for (int i = 0; i < 600 && report.empty(); ++i) {
+    ros::Duration(0.1).sleep();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (reports.size() > before)
+      report = reports.back();
+  }
+  ASSERT_FALSE(report.empty()) << "no registration within 60 s of the plan's end";
+  EXPECT_NE(report.find("8 of 8 views registered"), std::string::npos) << report;
 }
 
 }  // namespace

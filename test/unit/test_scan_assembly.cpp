@@ -86,6 +86,20 @@ TEST(AssembleRangeImage, ContinuousSweepGivesEachBeamItsTheta) {
   EXPECT_THROW(assembleRangeImage(lines, h, -1.0, 1.0), Error);
 }
 
+TEST(RangeImage, MiddleStampSkipsRowsWithoutALine) {
+  RangeImage img;
+  EXPECT_FALSE(img.middleStamp().has_value());
+  img.row_stamp = {10.0, 10.1, 10.2, 10.3, 10.4};
+  EXPECT_DOUBLE_EQ(*img.middleStamp(), 10.2);
+  // A missing middle line (stamp 0) would stamp the view at time 0, "the latest" to tf.
+  img.row_stamp = {10.0, 0.0, 0.0, 10.3, 10.4};
+  EXPECT_DOUBLE_EQ(*img.middleStamp(), 10.3);
+  img.row_stamp = {10.0, 10.1, 0.0, 10.3, 10.4};
+  EXPECT_DOUBLE_EQ(*img.middleStamp(), 10.1);  // equally near: the earlier
+  img.row_stamp = {0.0, 0.0, 0.0, 0.0};
+  EXPECT_FALSE(img.middleStamp().has_value());
+}
+
 TEST(FloatingPixels, Equation1OnKnownImages) {
   RangeImage img;
   img.resize(4, 5);

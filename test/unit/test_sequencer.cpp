@@ -56,6 +56,17 @@ TEST(Sequencer, RetriesReportsFailuresAndGoesOn) {
   const std::string md = outcomesMarkdown(out, 6);
   EXPECT_EQ(md.rfind("5 of 6 planned views acquired", 0), 0u) << md;
   EXPECT_NE(md.find("| 5 | FAILED | 3 |"), std::string::npos) << md;
+  // The plan's end message carries the count a replay's registration waits for.
+  EXPECT_EQ(viewsAcquired("finished: " + md.substr(0, md.find('\n'))), 5);
+}
+
+TEST(Sequencer, ReadsTheViewCountOfAPlansEnd) {
+  EXPECT_EQ(viewsAcquired("finished: 38 of 40 planned views acquired, 279.45 s of scanning."), 38);
+  EXPECT_EQ(viewsAcquired("finished: 0 of 40 planned views acquired (run stopped after 3), 1 s"),
+            0);
+  EXPECT_FALSE(viewsAcquired("22 of 40 views done, 1 failed: view 23 done").has_value());
+  EXPECT_FALSE(viewsAcquired("finished").has_value());
+  EXPECT_FALSE(viewsAcquired("finished: 99999999999999 of 40 planned views acquired"));
 }
 
 TEST(Sequencer, StopsWhenTheOperatorOrTheUserCancels) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "dormant_tree_modeling/common/cloud.h"
@@ -38,6 +39,9 @@ struct RangeImage {
   double phi(int col) const { return phi0 + col * phi_step; }
   /// @brief Number of valid pixels.
   std::size_t validCount() const;
+  /// @brief The image's time: the middle row's stamp, or that of the row nearest the middle
+  /// that has a scan line (rows without one have stamp 0). None without row stamps.
+  std::optional<double> middleStamp() const;
 };
 
 /// @brief Rotary-stage frame coordinates of a return (architecture.md):

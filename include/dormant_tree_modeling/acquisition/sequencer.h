@@ -1,6 +1,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,12 @@ std::vector<ViewOutcome> runPlan(const std::vector<PlannedView>& plan,
 
 /// @brief The outcomes as a Markdown table with a summary line.
 std::string outcomesMarkdown(const std::vector<ViewOutcome>& outcomes, int planned);
+
+/// @brief How many views a plan's end message says were acquired.
+/// @param message the acquisition's "finished: N of M planned views acquired, ..." (the
+///        summary line of outcomesMarkdown after "finished: ")
+/// @return N, or none when the message is not a plan's end in that form
+std::optional<int> viewsAcquired(const std::string& message);
 
 }  // namespace acquisition
 }  // namespace dormant_tree_modeling

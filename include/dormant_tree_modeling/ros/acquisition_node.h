@@ -1,15 +1,17 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <std_srvs/Trigger.h>
-#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <topic_tools/shape_shifter.h>
 
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "dormant_tree_modeling/acquisition/sequencer.h"
@@ -45,6 +47,8 @@ class AcquisitionNode {
   bool askForPlatform(const acquisition::PlannedView& view);
   void record(const std::string& topic, const topic_tools::ShapeShifter::ConstPtr& msg);
   void publish(ros::Publisher& pub, const std::string& text);
+  /// Sends the platform's pose again, stamped now, so that tf has it at every view's time.
+  void republishPlatform();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_;
@@ -62,7 +66,12 @@ class AcquisitionNode {
   ros::Timer diagnostics_timer_;
   ros::ServiceServer start_srv_, cancel_srv_, in_place_srv_;
   std::vector<ros::Subscriber> recorders_;
-  tf2_ros::StaticTransformBroadcaster static_tf_;
+  /// The plan's pose of the platform, `orchard` -> platform, republished on /tf (not
+  /// /tf_static): a view is looked up at its own time, so a replay that delivers the next
+  /// position's pose early does not move the views before it.
+  tf2_ros::TransformBroadcaster platform_tf_pub_;
+  std::optional<geometry_msgs::TransformStamped> platform_tf_;
+  ros::Timer platform_tf_timer_;
 
   std::mutex bag_mutex_;
   rosbag::Bag bag_;

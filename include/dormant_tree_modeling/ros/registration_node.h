@@ -7,7 +7,6 @@
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <mutex>
 #include <optional>
@@ -17,6 +16,7 @@
 
 #include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -28,7 +28,9 @@ namespace ros_layer {
 /// platform transform (the plan's or the operator's estimate, used only as a hint) did not
 /// change belong to one station; without that transform every view is its own station.
 /// Registers on `~register` (std_srvs/Trigger), when `~expected_views` have arrived, or when
-/// the acquisition reports "finished" on `~plan_progress_topic`, on a worker thread.
+/// the acquisition reports "finished" on `~plan_progress_topic`, on a worker thread. A
+/// "finished" that names more views than have arrived (a replay: the scan assembler is still
+/// assembling the last sweeps) waits up to `~finished_wait` wall-clock seconds for them.
 /// Publishes, latched, `~tree_cloud` (the registered views, frame `~tree_frame` = the first
 /// registered view's platform frame), `~view_poses` (geometry_msgs/PoseArray in that frame, one
 /// per input view, registered or not) and `~report` (std_msgs/String, the Markdown report), and
@@ -47,6 +49,8 @@ class RegistrationNode {
  private:
   void viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
   void progressCallback(const std_msgs::StringConstPtr& msg);
+  /// The plan's end named views that have not arrived within `~finished_wait`.
+  void finishedWaitExpired();
   bool registerService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   /// Starts a registration of the collected views on the worker; false (and why) when busy
@@ -58,24 +62,29 @@ class RegistrationNode {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   registration::RegistrationConfig config_;
+  ros::NodeHandle nh_;
   std::string orchard_frame_, tree_frame_, laser_frame_, output_dir_;
   int expected_views_ = 0;
   double hint_timeout_ = 0.5;
+  double finished_wait_ = 10.0;
 
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_{tf_buffer_};
+  tf2_ros::Buffer tf_buffer_{ros::Duration(TF_CACHE_S)};
+  TfFeed tf_feed_{tf_buffer_};
   tf2_ros::StaticTransformBroadcaster static_tf_;
   ros::Subscriber view_sub_, progress_sub_;
   ros::Publisher cloud_pub_, poses_pub_, report_pub_;
   ros::ServiceServer register_srv_, reset_srv_;
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;
+  ros::WallTimer finished_timer_;
 
   std::mutex mutex_;
   std::vector<registration::ViewInput> views_;
   std::optional<Eigen::Isometry3d> last_hint_;
   int next_station_ = 0;
   ros::Time last_stamp_;
+  /// Set between a plan's end and the arrival of the views it names.
+  std::optional<int> awaited_views_;
   bool busy_ = false;
   std::string last_outcome_ = "no registration yet";
   bool last_ok_ = true;

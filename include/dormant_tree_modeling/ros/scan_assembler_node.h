@@ -6,7 +6,6 @@
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <condition_variable>
 #include <deque>
@@ -17,6 +16,7 @@
 #include "dormant_tree_modeling/acquisition/sweep_recorder.h"
 #include "dormant_tree_modeling/acquisition/sweep_watcher.h"
 #include "dormant_tree_modeling/acquisition/view_processing.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -54,6 +54,9 @@ class ScanAssemblerNode {
   /// Processes one assembled sweep into a view and publishes it; returns a summary or throws.
   std::string publishView(acquisition::RangeImage image, std::size_t dropped, std::size_t missing,
                           const ros::WallTime& started);
+  /// Passive mode: waits, however long, for a scan line stamped after `stamp`; false when the
+  /// node shuts down first.
+  bool awaitLineAfter(double stamp);
   /// The target trunk's base as the plan expects it in the platform frame: the origin of
   /// `~tree_frame` through tf when known, else `~tree_distance` straight ahead (z NaN).
   Eigen::Vector3d treeHint(const ros::Time& stamp);
@@ -74,8 +77,8 @@ class ScanAssemblerNode {
   ros::Subscriber scan_sub_, joint_sub_;
   ros::Publisher cloud_pub_, image_pub_;
   ros::ServiceServer acquire_srv_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::Buffer tf_buffer_{ros::Duration(TF_CACHE_S)};
+  TfFeed tf_feed_{tf_buffer_};
 
   std::unique_ptr<acquisition::SweepRecorder> recorder_;  // scans and stage positions
   std::mutex acquire_mutex_;                              // one sweep at a time

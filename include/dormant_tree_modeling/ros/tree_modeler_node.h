@@ -5,7 +5,6 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <condition_variable>
 #include <mutex>
@@ -13,6 +12,7 @@
 #include <thread>
 
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -55,8 +55,8 @@ class TreeModelerNode {
 
   modeling::TreeModeler modeler_;
   std::string output_dir_, output_frame_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_{tf_buffer_};
+  tf2_ros::Buffer tf_buffer_{ros::Duration(TF_CACHE_S)};
+  TfFeed tf_feed_{tf_buffer_};
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;
   ros::Subscriber cloud_sub_;
