@@ -29,6 +29,10 @@ constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for 
 // through branch bases read wide, never narrow.
 constexpr double TAPER_BELOW = 2.5;
 constexpr double TAPER_ABOVE = 2.0;
+// From this estimated noise on, circles through branch bases and clutter outnumber the honest
+// slices' scatter: only slices within one robust sigma above the profile stay in its fit.
+constexpr double TAPER_NOISY_SIGMA = 0.010;
+constexpr double TAPER_ABOVE_NOISY = 1.0;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -626,7 +630,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
   if (config.ours_correct_noise_bias && config.trunk_taper_profile) {
-    if (const auto profile = TaperProfile::fit(slices, h, TAPER_BELOW, TAPER_ABOVE)) {
+    if (const auto profile = TaperProfile::fit(
+            slices, h, TAPER_BELOW, sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE)) {
       for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
         const auto& [a, b] = trunk.cylinder_ranges[i];
         trunk.cylinders[i].radius = std::max(MIN_TRUNK_RADIUS, profile->mean(a, b));
