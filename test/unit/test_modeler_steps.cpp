@@ -394,7 +394,7 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);  // trunk
   const std::size_t trunk_points = pts.size();
   addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);     // a primary
-  addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.008, 0.14);     // a 14 cm stub
+  addCylinder(pts, {-0.03, 0, 1.0}, {-1, 0, 0}, 0.008, 0.11);     // an 11 cm stub
   addCylinder(pts, {0, 0.03, 0.15}, {0, 1, 0}, 0.01, 0.4);        // at the soil
   addCylinder(pts, {0.032, -0.6, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // a wire passing the trunk
   addCylinder(pts, {0.032, 0.05, 1.2}, {0, 1, 0}, 0.0015, 0.55);  // and on past it

@@ -109,7 +109,7 @@ struct ModelerConfig {
   double branch_min_elevation = -30.0;  ///< deg above the trunk's normal plane (primaries: >= -20)
   double branch_max_diameter_ratio = 1.0;  ///< a primary is not thicker than the trunk there
   double branch_axis_gap = 0.10;    ///< branch axis must pass this close to the trunk surface
-  double branch_min_length = 0.12;  ///< shorter detections are fragments (primaries: >= 0.2 m)
+  double branch_min_length = 0.08;  ///< shorter fits are fragments (a 0.2 m primary shows ~0.1 m)
   double branch_min_height = 0.3;   ///< no primary attaches lower above the trunk base (m)
   double branch_inner_gap =
       0.05;  ///< shell branch candidates start this far out from the trunk surface
