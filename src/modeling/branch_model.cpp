@@ -18,6 +18,14 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double MIN_BRANCH_RADIUS = 0.002;
 constexpr double SURFACE_CONTACT = 0.05;
+// A fit cut off from the trunk surface (branch_keep_cut_off): its way back to the trunk is
+// walked in steps, each holding a share of the returns around the fit's centre, and part of it
+// must lie off every accepted fit.
+constexpr double CUT_WALK_STEP = 0.01;    // m
+constexpr double CUT_WALK_REACH = 1.0;    // m, beyond any fit's way back
+constexpr double CUT_FILL_SHARE = 0.2;    // of the returns around the fit's centre, per step
+constexpr int CUT_FILL_MIN_POINTS = 3;    // per step, however sparse the fit
+constexpr double CUT_MIN_OWN_WAY = 0.03;  // m of the way off accepted fits
 // A candidate of this many times branch_min_points whose fit is too short is split and retried.
 constexpr int SHORT_SPLIT = 12;
 constexpr double STEEP_ELONGATION = 16.0;  // variance ratio (4:1 in length) of a directed cluster
@@ -164,6 +172,60 @@ bool sameBranch(const BranchFit& a, const BranchFit& b) {
          (ca.center - cb.center).norm() < DUPLICATE_REACH;
 }
 
+/// Walks a fit's axis from its centre towards the trunk (against the axis, which points away)
+/// and calls visit(q) for each step at most `gap` off the trunk surface until `inner_gap` or
+/// the axis' closest approach to the trunk; stops early, returning false, when visit does.
+template <typename Visit>
+bool walkToSurface(const Cylinder& fit, const Cylinder& seg, double inner_gap, double gap,
+                   Visit visit) {
+  double last = 1e300;
+  for (double t = 0.0; t < CUT_WALK_REACH; t += CUT_WALK_STEP) {
+    const Eigen::Vector3d q = fit.center - t * fit.axis;
+    const double d = axisDistance(seg, q) - seg.radius;
+    if (d < inner_gap || d > last)
+      return true;
+    last = d;
+    if (d <= gap && !visit(q))
+      return false;
+  }
+  return false;
+}
+
+/// Whether returns fill a fit's axis from inner_gap off the trunk surface out to the fit's
+/// nearest point (gap), at CUT_FILL_SHARE of the density around the fit's centre: a branch
+/// crossing another near the trunk is cut in two by the other's extraction, and its outer
+/// part starts away from the surface, while a neighbour's tip or a shoot in the shell has air
+/// between it and the trunk.
+bool filledToSurface(const Cylinder& fit, const Cylinder& seg, const PointIndex& index,
+                     double inner_gap, double gap, double tube) {
+  const double own = static_cast<double>(index.within(fit.center, tube).size());
+  const int needed =
+      std::max(CUT_FILL_MIN_POINTS, static_cast<int>(std::ceil(CUT_FILL_SHARE * own)));
+  return walkToSurface(fit, seg, inner_gap, gap, [&](const Eigen::Vector3d& q) {
+    return index.countWithin(q, tube, needed) >= needed;
+  });
+}
+
+/// How much of the way from a fit to the trunk lies off every accepted fit (m): there the
+/// returns are the fit's own near part, cut off by a crossing branch's extraction. A shoot's
+/// way back runs inside its parent, and a piece of an accepted branch inside that branch.
+double ownWayToSurface(const Cylinder& fit, const Cylinder& seg,
+                       const std::vector<BranchFit>& accepted, double inner_gap, double gap,
+                       double tube) {
+  double own = 0.0;
+  walkToSurface(fit, seg, inner_gap, gap, [&](const Eigen::Vector3d& q) {
+    for (const auto& b : accepted) {
+      const Cylinder& c = b.cylinder;
+      if (axisDistance(c, q) < c.radius + tube &&
+          std::abs((q - c.center).dot(c.axis)) < 0.5 * c.length)
+        return true;
+    }
+    own += CUT_WALK_STEP;
+    return true;
+  });
+  return own;
+}
+
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,
@@ -223,6 +285,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     std::optional<Eigen::Vector3d> ray;
   };
   std::vector<Candidate> work;
+  // Fits whose points start away from the trunk surface with returns filling the way there.
+  struct CutFit {
+    BranchFit fit;
+    double gap;  // of its nearest point from the trunk surface
+    RejectedBranch as_rejected;
+  };
+  std::vector<CutFit> cut;
   for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
     work.push_back({*it, std::nullopt});
   int extractions = 0;
@@ -383,6 +452,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     }
     if (cyl->axis.dot(radial) < 0.0)
       cyl->axis = -cyl->axis;
+    bool reaches_surface = true;
     Eigen::Vector3d attachment;
     const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
     if (config.ours_constrain_ransac) {
@@ -419,7 +489,11 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         continue;
       }
       const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
-      if (nearest_gap > SURFACE_CONTACT + reach) {
+      reaches_surface = nearest_gap <= SURFACE_CONTACT + reach;
+      // A branch crossing this one near the trunk may have taken its near part out with it.
+      if (!reaches_surface &&
+          !(config.branch_keep_cut_off &&
+            filledToSurface(*cyl, seg, index, reach, nearest_gap, cyl->radius + threshold))) {
         reject("not at the surface", true);
         continue;
       }
@@ -461,9 +535,29 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     fit.candidates = sub.size();
     fit.trunk_segment = segment;
     fit.attachment = attachment;
-    branches.push_back(std::move(fit));
+    fit.reaches_surface = reaches_surface;
+    if (reaches_surface) {
+      branches.push_back(std::move(fit));
+    } else {
+      cut.push_back(
+          {std::move(fit), nearest_gap, rejection(cand_pts, cluster, "not at the surface")});
+    }
     if (config.ours_constrain_ransac)
       searchRest(*cyl);
+  }
+  // A fit cut off from the trunk is judged once every branch reaching the trunk is known: its
+  // way back must not lie all inside them.
+  const double inner = config.ours_branch_shell ? config.branch_inner_gap : threshold;
+  for (auto& c : cut) {
+    const Cylinder& seg = trunk.cylinders[c.fit.trunk_segment];
+    const double own = ownWayToSurface(c.fit.cylinder, seg, branches, inner, c.gap,
+                                       c.fit.cylinder.radius + threshold);
+    if (own < CUT_MIN_OWN_WAY) {
+      if (rejected)
+        rejected->push_back(c.as_rejected);
+      continue;
+    }
+    branches.push_back(std::move(c.fit));
   }
   if (config.ours_constrain_ransac) {
     // One branch split into two clusters (a gap in its returns) appears twice: keep the larger.
@@ -472,8 +566,14 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
         if (drop[i] || drop[k])
           continue;
-        if (sameBranch(branches[i], branches[k]))
-          drop[branches[i].inliers.size() >= branches[k].inliers.size() ? k : i] = 1;
+        if (!sameBranch(branches[i], branches[k]))
+          continue;
+        const auto& a = branches[i];
+        const auto& b = branches[k];
+        const bool keep_a = a.reaches_surface != b.reaches_surface
+                                ? a.reaches_surface
+                                : a.inliers.size() >= b.inliers.size();
+        drop[keep_a ? k : i] = 1;
       }
     }
     removeMarked(branches, drop, "duplicate", rejected);

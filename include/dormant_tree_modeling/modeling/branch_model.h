@@ -18,6 +18,9 @@ struct BranchFit {
   std::vector<int> inliers;    ///< indices into the modeled cloud
   std::size_t candidates = 0;  ///< points of its candidate cluster within the fit length
   Eigen::Vector3d attachment = Eigen::Vector3d::Zero();  ///< on the trunk axis
+  /// False when its points start away from the trunk surface and only other returns fill the
+  /// way there (a crossing branch took its near part): it yields to a duplicate that reaches it.
+  bool reaches_surface = true;
 };
 
 /// @brief A branch candidate that was turned down, and why (for diagnostics).

@@ -96,6 +96,11 @@ struct ModelerConfig {
   /// rays through the clutter of a cloud's few fused candidates pass as branches more often
   /// than they part real ones (3 and 6 mm noise: F1 -0.1 to -0.5).
   double branch_ray_split_min_noise = 0.008;
+  /// A fit whose points start farther than branch_inner_gap + 5 cm off the trunk surface is
+  /// kept when returns fill its way back to the trunk and part of that way lies off every
+  /// accepted branch: at centimetre noise a branch crossing it near the trunk takes its near
+  /// part out with its own points. Off: such fits are turned down ("not at the surface").
+  bool branch_keep_cut_off = true;
   /// A detection with fewer inliers than this fraction of the median over the tree's
   /// detections is dropped (a shoot on a primary, a neighbour's branch tip, a streak of mixed
   /// pixels); 0: off. Needs at least 4 detections.
