@@ -67,6 +67,7 @@ const std::map<std::string, Setter>& setters() {
       {"curvature_jump", setter(&C::curvature_jump)},
       {"min_segment_length", setter(&C::min_segment_length)},
       {"trunk_max_bend", setter(&C::trunk_max_bend)},
+      {"trunk_max_segment_length", setter(&C::trunk_max_segment_length)},
       {"trunk_taper_profile", setter(&C::trunk_taper_profile)},
       {"branch_ray_split", setter(&C::branch_ray_split)},
       {"branch_keep_cut_off", setter(&C::branch_keep_cut_off)},
@@ -150,6 +151,7 @@ ModelerConfig ModelerConfig::paper() {
   c.ours_correct_noise_bias = false;
   c.ours_branch_shell = false;
   c.trunk_max_bend = 0.0;
+  c.trunk_max_segment_length = 0.0;
   c.trunk_taper_profile = false;
   c.branch_ray_split = false;
   c.branch_keep_cut_off = false;
@@ -176,6 +178,8 @@ void ModelerConfig::validate() const {
   check("curvature_jump", curvature_jump, 0.01, 1.0);
   check("min_segment_length", min_segment_length, 0.02, 5.0);
   check("trunk_max_bend", trunk_max_bend, 0.0, 1.0);
+  if (trunk_max_segment_length != 0.0)
+    check("trunk_max_segment_length", trunk_max_segment_length, 2.0 * min_segment_length, 10.0);
   check("branch_cluster_tolerance", branch_cluster_tolerance, 0.002, 0.5);
   check("branch_min_points", branch_min_points, 6, 1000000);
   check("branch_fit_length", branch_fit_length, 0.05, 2.0);

@@ -610,6 +610,18 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     }
     final_cuts = std::move(straight);
   }
+  if (config.trunk_max_segment_length > 0.0) {
+    std::vector<double> short_cuts{final_cuts.front()};
+    for (std::size_t i = 1; i < final_cuts.size(); ++i) {
+      const double a = short_cuts.back(), b = final_cuts[i];
+      const int parts =
+          static_cast<int>(std::ceil((b - a) / config.trunk_max_segment_length - 1e-9));
+      for (int k = 1; k < parts; ++k)
+        short_cuts.push_back(a + (b - a) * k / parts);
+      short_cuts.push_back(b);
+    }
+    final_cuts = std::move(short_cuts);
+  }
   trunk.partitions = final_cuts;
   for (std::size_t i = 0; i + 1 < final_cuts.size(); ++i) {
     const double a = final_cuts[i], b = final_cuts[i + 1];

@@ -78,6 +78,10 @@ struct ModelerConfig {
   /// over the bend lies centimetres off the wood and the branch search misplaces the trunk
   /// surface). 0: off (the paper's segments).
   double trunk_max_bend = 0.03;
+  /// A trunk segment longer than this (m) is cut into equal parts no longer: a trunk tapers
+  /// and bends along metres without a disturbance to cut at, and one cylinder over 2-3 m sits
+  /// centimetres off the wood and too wide at its top. 0: off (the paper's segments).
+  double trunk_max_segment_length = 0.9;
   /// With ours_correct_noise_bias: trunk segment radii from one smooth taper profile fitted to
   /// all slices (robust to slices through branch bases), not each segment's median slice.
   bool trunk_taper_profile = true;

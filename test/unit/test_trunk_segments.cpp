@@ -1,0 +1,96 @@
+// Trunk segments no longer than trunk_max_segment_length: a trunk tapers along metres without
+// a disturbance to cut at.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <vector>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/radius_calibration.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+constexpr double HEIGHT = 2.4;
+
+/// A straight trunk tapering from 5 cm radius at the soil to 1.5 cm at 2.4 m.
+double taper(double z) {
+  return 0.05 + (0.015 - 0.05) * z / HEIGHT;
+}
+
+Points taperedTrunk() {
+  Points pts;
+  for (double z = 0.0; z <= HEIGHT; z += 0.005) {
+    for (int k = 0; k < 48; ++k) {
+      const double phi = 2.0 * M_PI * k / 48;
+      pts.emplace_back(taper(z) * std::cos(phi), taper(z) * std::sin(phi), z);
+    }
+  }
+  return pts;
+}
+
+TrunkModel modelTapered(double max_segment_length) {
+  const Points pts = taperedTrunk();
+  std::vector<int> region(pts.size());
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  // No beam, no noise: the sensor model's diameter calibration does not apply.
+  config.noise_sigma = 0.0;
+  config.beam_spread = 0.0;
+  config.trunk_calibration = RadiusCalibration{};
+  config.trunk_max_segment_length = max_segment_length;
+  return modelTrunk(pts, region, {{0, 0, 0}, {0, 0, HEIGHT}}, 0.05, config);
+}
+
+/// The largest difference between a segment's radius and the trunk's at the segment's ends.
+double worstEndError(const TrunkModel& trunk) {
+  double worst = 0.0;
+  for (const auto& c : trunk.cylinders) {
+    for (const double end : {-0.5, 0.5}) {
+      const double z = (c.center + end * c.length * c.axis).z();
+      worst = std::max(worst, std::abs(c.radius - taper(std::clamp(z, 0.0, HEIGHT))));
+    }
+  }
+  return worst;
+}
+
+double longest(const TrunkModel& trunk) {
+  double l = 0.0;
+  for (const auto& [a, b] : trunk.cylinder_ranges)
+    l = std::max(l, b - a);
+  return l;
+}
+
+TEST(TrunkSegments, ALongTaperedTrunkIsCutIntoShortSegments) {
+  const TrunkModel whole = modelTapered(0.0);
+  const TrunkModel cut = modelTapered(0.6);
+  std::printf(
+      "[ INFO ] uncut: %zu segments, longest %.2f m, radius off by %.1f mm at an end; "
+      "cut: %zu, %.2f m, %.1f mm\n",
+      whole.cylinders.size(), longest(whole), 1000 * worstEndError(whole), cut.cylinders.size(),
+      longest(cut), 1000 * worstEndError(cut));
+  EXPECT_GT(longest(whole), 0.6);
+  EXPECT_LE(longest(cut), 0.6 + 1e-9);
+  EXPECT_GE(cut.cylinders.size(), 4u);
+  // The radius of a 0.6 m segment misses its ends by half its taper, 4.4 mm, at most.
+  EXPECT_LT(worstEndError(cut), 0.0045);
+  EXPECT_GT(worstEndError(whole), 0.01);
+}
+
+TEST(TrunkSegments, ALengthBelowTwoShortestSegmentsIsRefused) {
+  ModelerConfig config;
+  config.trunk_max_segment_length = 0.2;  // min_segment_length is 0.15
+  EXPECT_THROW(config.validate(), Error);
+  config.trunk_max_segment_length = 0.0;
+  EXPECT_NO_THROW(config.validate());
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
