@@ -560,7 +560,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     branches.push_back(std::move(c.fit));
   }
   if (config.ours_constrain_ransac) {
-    // One branch split into two clusters (a gap in its returns) appears twice: keep the larger.
+    // One branch split into two clusters (a gap in its returns) appears twice: keep the one
+    // that reaches the trunk surface, else the larger.
     std::vector<char> drop(branches.size(), 0);
     for (std::size_t i = 0; i < branches.size(); ++i) {
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
