@@ -292,6 +292,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     RejectedBranch as_rejected;
   };
   std::vector<CutFit> cut;
+  // How far off the trunk surface candidates start: a branch's points begin there or closer.
+  const double inner_gap = config.ours_branch_shell ? config.branch_inner_gap : threshold;
   for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
     work.push_back({*it, std::nullopt});
   int extractions = 0;
@@ -488,12 +490,11 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
         reject("misses the trunk", true);
         continue;
       }
-      const double reach = config.ours_branch_shell ? config.branch_inner_gap : threshold;
-      reaches_surface = nearest_gap <= SURFACE_CONTACT + reach;
+      reaches_surface = nearest_gap <= SURFACE_CONTACT + inner_gap;
       // A branch crossing this one near the trunk may have taken its near part out with it.
       if (!reaches_surface &&
           !(config.branch_keep_cut_off &&
-            filledToSurface(*cyl, seg, index, reach, nearest_gap, cyl->radius + threshold))) {
+            filledToSurface(*cyl, seg, index, inner_gap, nearest_gap, cyl->radius + threshold))) {
         reject("not at the surface", true);
         continue;
       }
@@ -547,10 +548,9 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
   }
   // A fit cut off from the trunk is judged once every branch reaching the trunk is known: its
   // way back must not lie all inside them.
-  const double inner = config.ours_branch_shell ? config.branch_inner_gap : threshold;
   for (auto& c : cut) {
     const Cylinder& seg = trunk.cylinders[c.fit.trunk_segment];
-    const double own = ownWayToSurface(c.fit.cylinder, seg, branches, inner, c.gap,
+    const double own = ownWayToSurface(c.fit.cylinder, seg, branches, inner_gap, c.gap,
                                        c.fit.cylinder.radius + threshold);
     if (own < CUT_MIN_OWN_WAY) {
       if (rejected)
