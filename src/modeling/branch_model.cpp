@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_rays.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
@@ -247,8 +248,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
   // Candidate points and where they sit.
   std::vector<int> candidates;
   std::vector<TrunkCoords> where;
-  auto consider = [&](int i) {
-    const TrunkCoords c = locate(trunk, pts[i]);
+  // Where every point sits, on all cores; then the candidates in index order.
+  const int n_points = static_cast<int>(config.ours_branch_shell ? pts.size() : region.size());
+  std::vector<TrunkCoords> located(n_points);
+  parallelFor(n_points, [&](int k) {
+    located[k] = locate(trunk, pts[config.ours_branch_shell ? k : region[k]]);
+  });
+  auto consider = [&](int i, const TrunkCoords& c) {
     if (c.segment < 0 || c.s < s_lo || c.s > s_hi)
       return;
     const double r = trunk.cylinders[c.segment].radius;
@@ -263,13 +269,8 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     candidates.push_back(i);
     where.push_back(c);
   };
-  if (config.ours_branch_shell) {
-    for (std::size_t i = 0; i < pts.size(); ++i)
-      consider(static_cast<int>(i));
-  } else {
-    for (const int i : region)
-      consider(i);
-  }
+  for (int k = 0; k < n_points; ++k)
+    consider(config.ours_branch_shell ? k : region[k], located[k]);
   Points cand_pts;
   for (const int i : candidates)
     cand_pts.push_back(pts[i]);

@@ -9,6 +9,7 @@ namespace modeling {
 
 Centerline::Centerline(std::vector<Eigen::Vector3d> vertices) : vertices_(std::move(vertices)) {
   cumulative_.push_back(0.0);
+  rising_ = vertices_.size() >= 2;
   for (std::size_t i = 1; i < vertices_.size(); ++i) {
     const Eigen::Vector3d ab = vertices_[i] - vertices_[i - 1];
     const double length = ab.norm();
@@ -18,29 +19,65 @@ Centerline::Centerline(std::vector<Eigen::Vector3d> vertices) : vertices_(std::m
     seg.direction = length > 0.0 ? Eigen::Vector3d(ab / length) : Eigen::Vector3d::Zero();
     seg.length = length;
     segments_.push_back(seg);
+    rising_ = rising_ && vertices_[i].z() > vertices_[i - 1].z();
   }
 }
 
+double Centerline::segmentDistance2(std::size_t i, const Eigen::Vector3d& p, double* s) const {
+  const Segment& seg = segments_[i];
+  const Eigen::Vector3d w = p - vertices_[i];
+  double t = w.dot(seg.direction);
+  // Beyond the first and last vertex the end segments extend the line.
+  if (i > 0)
+    t = std::max(t, 0.0);
+  if (i + 1 < segments_.size())
+    t = std::min(t, seg.length);
+  *s = cumulative_[i] + t;
+  return (w - t * seg.direction).squaredNorm();
+}
+
 double Centerline::project(const Eigen::Vector3d& p, double* distance) const {
-  // Squared distances and unit directions: projection is the inner loop of the trunk region,
-  // the point classes and the branch step, over every point and every segment.
+  // Projection is the inner loop of the trunk region, the point classes and the branch step,
+  // over every point. The answer is the first segment (in index order) at the least distance.
   double best_d2 = std::numeric_limits<double>::infinity(), best_s = 0.0;
+  std::size_t best_i = 0;
   const std::size_t n = segments_.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Segment& seg = segments_[i];
-    if (seg.length <= 0.0)
-      continue;
-    const Eigen::Vector3d w = p - vertices_[i];
-    double t = w.dot(seg.direction);
-    // Beyond the first and last vertex the end segments extend the line.
-    if (i > 0)
-      t = std::max(t, 0.0);
-    if (i + 1 < n)
-      t = std::min(t, seg.length);
-    const double d2 = (w - t * seg.direction).squaredNorm();
-    if (d2 < best_d2) {
+  const auto consider = [&](std::size_t i) {
+    if (segments_[i].length <= 0.0)
+      return;
+    double s = 0.0;
+    const double d2 = segmentDistance2(i, p, &s);
+    if (d2 < best_d2 || (d2 == best_d2 && i < best_i)) {
       best_d2 = d2;
-      best_s = cumulative_[i] + t;
+      best_s = s;
+      best_i = i;
+    }
+  };
+  if (!rising_ || n < 4) {
+    for (std::size_t i = 0; i < n; ++i)
+      consider(i);
+  } else {
+    // A rising polyline: an interior segment lies between its vertices' heights, so one whose
+    // height range is farther from p than the best distance so far cannot be closer. Start at
+    // p's height and walk down and up until that is so; the end segments (extended lines) are
+    // always measured.
+    consider(0);
+    consider(n - 1);
+    const auto above =
+        std::upper_bound(vertices_.begin() + 1, vertices_.end() - 1, p.z(),
+                         [](double z, const Eigen::Vector3d& v) { return z < v.z(); });
+    const std::size_t start = static_cast<std::size_t>(above - vertices_.begin()) - 1;
+    for (std::size_t i = std::min(start, n - 2); i >= 1; --i) {
+      const double gap = p.z() - vertices_[i + 1].z();
+      if (gap > 0.0 && gap * gap > best_d2)
+        break;
+      consider(i);
+    }
+    for (std::size_t i = std::max<std::size_t>(start + 1, 1); i + 1 < n; ++i) {
+      const double gap = vertices_[i].z() - p.z();
+      if (gap > 0.0 && gap * gap > best_d2)
+        break;
+      consider(i);
     }
   }
   if (distance)

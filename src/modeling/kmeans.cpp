@@ -147,16 +147,45 @@ std::vector<int> kMeans(const Points& pts, int k, int max_iterations, std::uint6
     upper[i] = std::sqrt(best_d);
     lower[i] = second_norm;
   };
+  // How far a scan from each centre can walk: its points' largest upper bound, per block and
+  // then per centre (a point of centre c never walks past 2 max upper + c's nearest gap).
+  std::vector<double> reach(k, 0.0);
+  std::vector<std::vector<double>> block_reach_of(blocks, std::vector<double>(k));
   for (int it = 0; it < max_iterations; ++it) {
+    if (it > 0) {
+      parallelFor(blocks, [&](int b) {
+        auto& row = block_reach_of[b];
+        std::fill(row.begin(), row.end(), 0.0);
+        const int end = std::min(n, (b + 1) * BLOCK);
+        for (int i = b * BLOCK; i < end; ++i)
+          row[labels[i]] = std::max(row[labels[i]], upper[i]);
+      });
+      std::fill(reach.begin(), reach.end(), 0.0);
+      for (int b = 0; b < blocks; ++b) {
+        for (int c = 0; c < k; ++c)
+          reach[c] = std::max(reach[c], block_reach_of[b][c]);
+      }
+    }
     parallelFor(k, [&](int c) {
       auto& row = by_distance[c];
       row.clear();
+      double nearest = std::numeric_limits<double>::infinity();
       for (int o = 0; o < k; ++o) {
-        if (o != c)
+        if (o != c) {
           row.emplace_back((centres[c] - centres[o]).norm(), o);
+          nearest = std::min(nearest, row.back().first);
+        }
       }
+      half_gap[c] = 0.5 * nearest;
+      // A scan starts at a point's own centre (distance u <= reach) and its first step finds a
+      // second-nearest within u + nearest: it stops before any centre farther than
+      // 2 reach + nearest from its own. Only those nearer are sorted (the first pass scans
+      // nothing: no row is needed). Same walk as over the whole sorted row.
+      const double cutoff = it == 0 ? -1.0 : 2.0 * reach[c] + nearest + 1e-6;
+      row.erase(std::partition(row.begin(), row.end(),
+                               [&](const std::pair<double, int>& e) { return e.first <= cutoff; }),
+                row.end());
       std::sort(row.begin(), row.end());
-      half_gap[c] = row.empty() ? std::numeric_limits<double>::infinity() : 0.5 * row[0].first;
     });
     // Assignment: independent per point, so it runs on every core with identical results (a
     // cluster's k-means inside splitClusters' parallel loop runs on its own thread).

@@ -386,8 +386,19 @@ ModelResult TreeModeler::model(const Points& input) const {
       // Algorithm 2 linked.
       const Centerline line(axis);
       const double reach = std::max(3.0 * radius, radius + 0.05);
+      // A near point's closest axis point lies within 5 cm of the vertices' box (the ends
+      // extend by that much), so a point farther than reach + 5 cm from the box is not near.
+      Eigen::Vector3d lo = axis.front(), hi = axis.front();
+      for (const auto& c : axis) {
+        lo = lo.cwiseMin(c);
+        hi = hi.cwiseMax(c);
+      }
+      lo.array() -= reach + 0.06;
+      hi.array() += reach + 0.06;
       std::vector<char> near(pts.size(), 0);
       parallelFor(static_cast<int>(pts.size()), [&](int i) {
+        if ((pts[i].array() < lo.array()).any() || (pts[i].array() > hi.array()).any())
+          return;
         double d = 0.0;
         const double s = line.project(pts[i], &d);
         near[i] = d <= reach && s >= -0.05 && s <= line.length() + 0.05;

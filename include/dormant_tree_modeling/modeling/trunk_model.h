@@ -27,6 +27,9 @@ class Centerline {
 
  private:
   std::size_t segmentAt(double s) const;
+  /// Squared distance from p to segment i (the end segments extended) and the arc length of
+  /// the closest point.
+  double segmentDistance2(std::size_t i, const Eigen::Vector3d& p, double* s) const;
   struct Segment {
     Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit, from vertex i to i + 1
     double length = 0.0;
@@ -34,6 +37,7 @@ class Centerline {
   std::vector<Eigen::Vector3d> vertices_;
   std::vector<Segment> segments_;
   std::vector<double> cumulative_;
+  bool rising_ = false;  ///< vertex heights strictly increase: project() searches by height
 };
 
 /// @brief One slice of Algorithm 3 step 1.
