@@ -7,6 +7,10 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
+namespace {
+constexpr int HOPE_CHECK = 64;  // points between checks that a RANSAC hypothesis can still win
+}  // namespace
+
 std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                                     const Eigen::Vector2d& c) {
   const double d =
@@ -94,15 +98,30 @@ std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions
     const auto c = circleThrough(pts[i], pts[j], pts[k]);
     if (!c || c->radius < o.min_radius || c->radius > o.max_radius)
       continue;
+    // Inliers from squared distances (a root only for the inliers' cost); a hypothesis that can
+    // no longer reach the best count is left early. Same choice as scoring every point.
+    const double inner = std::max(0.0, c->radius - o.threshold);
+    const double inner2 = c->radius > o.threshold ? inner * inner : -1.0;
+    const double outer2 = (c->radius + o.threshold) * (c->radius + o.threshold);
     int count = 0;
     double cost = 0.0;
-    for (const auto& p : pts) {
-      const double e = std::abs((p - c->center).norm() - c->radius);
-      if (e < o.threshold) {
-        ++count;
-        cost += e;
+    bool hopeless = false;
+    for (int start = 0; start < n && !hopeless; start += HOPE_CHECK) {
+      const int end = std::min(n, start + HOPE_CHECK);
+      for (int m = start; m < end; ++m) {
+        const double d2 = (pts[m] - c->center).squaredNorm();
+        if (d2 > inner2 && d2 < outer2) {
+          const double e = std::abs(std::sqrt(d2) - c->radius);
+          if (e < o.threshold) {
+            ++count;
+            cost += e;
+          }
+        }
       }
+      hopeless = count + (n - end) < best_count;
     }
+    if (hopeless)
+      continue;
     if (count > best_count || (count == best_count && cost < best_cost)) {
       best = c;
       best_count = count;
