@@ -20,12 +20,13 @@ namespace modeling {
 
 namespace {
 
-constexpr double GROUND_BAND = 0.03;         // m above the ground plane removed with it
-constexpr double GROUND_MIN_EXTENT = 0.8;    // m: a plane smaller than this is not the ground
-constexpr double WIRE_BAND = 0.025;          // m around a wire line: its noisy returns
-constexpr double WIRE_NEIGHBOURHOOD = 0.10;  // m, for the linearity test
-constexpr double WIRE_LINEARITY = 0.1;       // second / first eigenvalue below this: a line
-constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
+constexpr double GROUND_BAND = 0.03;          // m above the ground plane removed with it
+constexpr double GROUND_MIN_EXTENT = 0.8;     // m: a plane smaller than this is not the ground
+constexpr std::size_t GROUND_SAMPLE = 50000;  // low points that score a ground hypothesis
+constexpr double WIRE_BAND = 0.025;           // m around a wire line: its noisy returns
+constexpr double WIRE_NEIGHBOURHOOD = 0.10;   // m, for the linearity test
+constexpr double WIRE_LINEARITY = 0.1;        // second / first eigenvalue below this: a line
+constexpr double WIRE_MAX_GAP = 0.35;         // m: a wire's returns are never sparser than this
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr double WIRE_MAX_CROSSING = 10.0 * M_PI / 180.0;  // from the row's direction
 constexpr int MAX_WIRES = 10;
@@ -45,14 +46,21 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
   }
   if (low.size() < 50)
     return 0;
+  // Hypotheses are scored on at most GROUND_SAMPLE of the low points (a whole terrestrial scan
+  // has millions of ground returns; a tree's crop has a few thousand, all used).
+  std::vector<int> sample;
+  const std::size_t stride = (low.size() + GROUND_SAMPLE - 1) / GROUND_SAMPLE;
+  for (std::size_t k = 0; k < low.size(); k += stride)
+    sample.push_back(low[k]);
   Rng rng(seed);
   Eigen::Vector3d best_n = Eigen::Vector3d::UnitZ();
   double best_d = 0.0;
   std::size_t best_count = 0;
   for (int it = 0; it < 200; ++it) {
-    const auto& a = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
-    const auto& b = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
-    const auto& c = pts[low[rng.uniformInt(0, static_cast<int>(low.size()) - 1)]];
+    const int last = static_cast<int>(sample.size()) - 1;
+    const auto& a = pts[sample[rng.uniformInt(0, last)]];
+    const auto& b = pts[sample[rng.uniformInt(0, last)]];
+    const auto& c = pts[sample[rng.uniformInt(0, last)]];
     Eigen::Vector3d n = (b - a).cross(c - a);
     if (n.norm() < 1e-9)
       continue;
@@ -63,7 +71,7 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
       continue;
     const double d = -n.dot(a);
     std::size_t count = 0;
-    for (const int i : low)
+    for (const int i : sample)
       count += std::abs(n.dot(pts[i]) + d) < 0.02;
     if (count > best_count) {
       best_count = count;
@@ -79,7 +87,7 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
       hi = hi.cwiseMax(pts[i].head<2>());
     }
   }
-  if (best_count < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT)
+  if (best_count * stride < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT)
     return 0;
   const std::size_t before = pts.size();
   pts.erase(std::remove_if(
@@ -99,6 +107,26 @@ struct CellKeys {
   std::array<long, 3> hi{};                          ///< highest occupied cell per axis
   double cell = 0.0;                                 ///< edge (m)
 };
+
+/// Sorts (key, index) pairs, listed in increasing index, by key and then index: a stable LSD
+/// radix sort on the `bits` low bits of the key, 11 a pass (a comparison sort of millions of
+/// cells took most of a whole scan's voxel grid).
+void radixSortByKey(std::vector<std::pair<std::uint64_t, int>>& v, int bits) {
+  constexpr int DIGIT = 11;
+  constexpr std::uint64_t MASK = (1UL << DIGIT) - 1;
+  std::vector<std::pair<std::uint64_t, int>> moved(v.size());
+  std::vector<std::size_t> start(MASK + 2);
+  for (int shift = 0; shift < bits; shift += DIGIT) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const auto& e : v)
+      ++start[((e.first >> shift) & MASK) + 1];
+    for (std::size_t b = 1; b < start.size(); ++b)
+      start[b] += start[b - 1];
+    for (const auto& e : v)
+      moved[start[(e.first >> shift) & MASK]++] = e;
+    v.swap(moved);
+  }
+}
 
 /// Every point's grid cell (edge `cell`) with its index, sorted by cell and then by index:
 /// each cell's points form one run, in input order.
@@ -139,7 +167,7 @@ CellKeys sortedByCell(const Points& pts, double cell) {
       key += static_cast<std::uint64_t>(cells[i][a] - lo[a] + 1) * out.unit[a];
     out.keyed[i] = {key, static_cast<int>(i)};
   }
-  std::sort(out.keyed.begin(), out.keyed.end());
+  radixSortByKey(out.keyed, bits[0] + bits[1] + bits[2]);
   return out;
 }
 
