@@ -15,6 +15,8 @@
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
+#include "cell_grid.h"
+
 namespace dormant_tree_modeling {
 namespace modeling {
 
@@ -23,6 +25,7 @@ namespace {
 constexpr double GROUND_BAND = 0.03;          // m above the ground plane removed with it
 constexpr double GROUND_MIN_EXTENT = 0.8;     // m: a plane smaller than this is not the ground
 constexpr std::size_t GROUND_SAMPLE = 50000;  // low points that score a ground hypothesis
+constexpr double SPACING_CELL = 0.02;         // m, grid of medianSpacing() without an index
 constexpr double WIRE_BAND = 0.025;           // m around a wire line: its noisy returns
 constexpr double WIRE_NEIGHBOURHOOD = 0.10;   // m, for the linearity test
 constexpr double WIRE_LINEARITY = 0.1;        // second / first eigenvalue below this: a line
@@ -97,113 +100,6 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
   return before - pts.size();
 }
 
-/// Grid cells keyed by one integer: per axis the offset from one cell below the cloud's lowest,
-/// packed with x in the highest bits, so the keys sort as (x, y, z) do. Each axis has a spare
-/// cell at both ends: a face neighbour's key is the key plus or minus that axis's unit.
-struct CellKeys {
-  std::vector<std::pair<std::uint64_t, int>> keyed;  ///< (key, point index), sorted
-  std::array<std::uint64_t, 3> unit{};               ///< key step of one cell along x, y, z
-  std::array<long, 3> lo{};                          ///< lowest occupied cell per axis
-  std::array<long, 3> hi{};                          ///< highest occupied cell per axis
-  double cell = 0.0;                                 ///< edge (m)
-};
-
-/// Sorts (key, index) pairs, listed in increasing index, by key and then index: a stable LSD
-/// radix sort on the `bits` low bits of the key, 11 a pass (a comparison sort of millions of
-/// cells took most of a whole scan's voxel grid).
-void radixSortByKey(std::vector<std::pair<std::uint64_t, int>>& v, int bits) {
-  constexpr int DIGIT = 11;
-  constexpr std::uint64_t MASK = (1UL << DIGIT) - 1;
-  std::vector<std::pair<std::uint64_t, int>> moved(v.size());
-  std::vector<std::size_t> start(MASK + 2);
-  for (int shift = 0; shift < bits; shift += DIGIT) {
-    std::fill(start.begin(), start.end(), 0);
-    for (const auto& e : v)
-      ++start[((e.first >> shift) & MASK) + 1];
-    for (std::size_t b = 1; b < start.size(); ++b)
-      start[b] += start[b - 1];
-    for (const auto& e : v)
-      moved[start[(e.first >> shift) & MASK]++] = e;
-    v.swap(moved);
-  }
-}
-
-/// Every point's grid cell (edge `cell`) with its index, sorted by cell and then by index:
-/// each cell's points form one run, in input order.
-CellKeys sortedByCell(const Points& pts, double cell) {
-  CellKeys out;
-  out.keyed.resize(pts.size());
-  if (pts.empty())
-    return out;
-  std::vector<std::array<long, 3>> cells(pts.size());
-  std::array<long, 3> lo, hi;
-  lo.fill(std::numeric_limits<long>::max());
-  hi.fill(std::numeric_limits<long>::min());
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    for (int a = 0; a < 3; ++a) {
-      cells[i][a] = static_cast<long>(std::floor(pts[i](a) / cell));
-      lo[a] = std::min(lo[a], cells[i][a]);
-      hi[a] = std::max(hi[a], cells[i][a]);
-    }
-  }
-  std::array<int, 3> bits;
-  for (int a = 0; a < 3; ++a) {
-    bits[a] = 1;
-    while (bits[a] < 63 && (1UL << bits[a]) < static_cast<std::uint64_t>(hi[a] - lo[a] + 3))
-      ++bits[a];
-  }
-  if (bits[0] + bits[1] + bits[2] > 64) {
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "the cloud spans more grid cells of " + std::to_string(cell) +
-                    " m than 64-bit keys hold; use a larger cell (voxel_size)");
-  }
-  out.unit = {1UL << (bits[1] + bits[2]), 1UL << bits[2], 1UL};
-  out.lo = lo;
-  out.hi = hi;
-  out.cell = cell;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    std::uint64_t key = 0;
-    for (int a = 0; a < 3; ++a)
-      key += static_cast<std::uint64_t>(cells[i][a] - lo[a] + 1) * out.unit[a];
-    out.keyed[i] = {key, static_cast<int>(i)};
-  }
-  radixSortByKey(out.keyed, bits[0] + bits[1] + bits[2]);
-  return out;
-}
-
-/// Calls fn(q) for every point q of pts within radius of p (radius at most grid.cell), from
-/// the 3 x 3 x 3 cells around p's cell. p need not be one of pts.
-template <typename Fn>
-void forEachWithin(const CellKeys& grid, const Points& pts, const Eigen::Vector3d& p, double radius,
-                   const Fn& fn) {
-  std::array<long, 3> c;
-  for (int a = 0; a < 3; ++a)
-    c[a] = static_cast<long>(std::floor(p(a) / grid.cell));
-  const double r2 = radius * radius;
-  // Cells are numbered from one below the lowest occupied: keys exist for lo - 1 .. hi + 1.
-  const auto key = [&](long x, long y, long z) {
-    return static_cast<std::uint64_t>(x - grid.lo[0] + 1) * grid.unit[0] +
-           static_cast<std::uint64_t>(y - grid.lo[1] + 1) * grid.unit[1] +
-           static_cast<std::uint64_t>(z - grid.lo[2] + 1) * grid.unit[2];
-  };
-  const long z_lo = std::max(c[2] - 1, grid.lo[2]), z_hi = std::min(c[2] + 1, grid.hi[2]);
-  if (z_lo > z_hi)
-    return;
-  for (long x = std::max(c[0] - 1, grid.lo[0]); x <= std::min(c[0] + 1, grid.hi[0]); ++x) {
-    for (long y = std::max(c[1] - 1, grid.lo[1]); y <= std::min(c[1] + 1, grid.hi[1]); ++y) {
-      // z is the key's lowest part: the three cells of a column are one run of keys.
-      const std::uint64_t first = key(x, y, z_lo), last = key(x, y, z_hi);
-      auto it = std::lower_bound(grid.keyed.begin(), grid.keyed.end(),
-                                 std::make_pair(first, std::numeric_limits<int>::min()));
-      for (; it != grid.keyed.end() && it->first <= last; ++it) {
-        const Eigen::Vector3d& q = pts[it->second];
-        if ((q - p).squaredNorm() <= r2)
-          fn(q);
-      }
-    }
-  }
-}
-
 /// Longest run of projections along a line without a gap above WIRE_MAX_GAP.
 double longestRun(std::vector<double>& t) {
   if (t.empty())
@@ -228,7 +124,7 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
   // ball is gathered from the 27 cells of a 10 cm grid around the point (cheaper than a k-d
   // tree for 20000 balls of hundreds of points each; the same points).
   const Points coarse = voxelDownsample(pts, WIRE_TEST_VOXEL);
-  const CellKeys grid = sortedByCell(coarse, WIRE_NEIGHBOURHOOD);
+  const detail::CellKeys grid = detail::sortedByCell(coarse, WIRE_NEIGHBOURHOOD);
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);
   const int samples = static_cast<int>((pts.size() + stride - 1) / stride);
   std::vector<char> linear(samples, 0);
@@ -237,11 +133,14 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
     int count = 0;
-    forEachWithin(grid, coarse, p, WIRE_NEIGHBOURHOOD, [&](const Eigen::Vector3d& q) {
-      const Eigen::Vector3d d = q - p;  // small offsets: the one-pass covariance stays exact
-      sum += d;
-      outer.noalias() += d * d.transpose();
-      ++count;
+    detail::forEachInCube(grid, p, 1, [&](int j) {
+      const Eigen::Vector3d d = coarse[j] - p;  // small offsets: a one-pass covariance is exact
+      if (d.squaredNorm() <= WIRE_NEIGHBOURHOOD * WIRE_NEIGHBOURHOOD) {
+        sum += d;
+        outer.noalias() += d * d.transpose();
+        ++count;
+      }
+      return true;
     });
     if (count < 8)
       return;
@@ -348,61 +247,31 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
   return removed;
 }
 
-}  // namespace
-
-double medianSpacing(const Points& pts) {
-  if (pts.size() < 2)
-    return 0.0;
-  return medianSpacing(pts, PointIndex(pts));
+/// The sample medianSpacing() measures: every stride-th point, about 2000.
+std::size_t spacingStride(std::size_t n) {
+  return std::max<std::size_t>(1, n / 2000);
 }
 
-double medianSpacing(const Points& pts, const PointIndex& index) {
-  if (pts.size() < 2)
-    return 0.0;
-  const std::size_t stride = std::max<std::size_t>(1, pts.size() / 2000);
+/// medianSpacing() from a grid of the points (any cell size; the same neighbours as the index).
+double spacingFromGrid(const Points& pts, const detail::CellKeys& grid) {
   std::vector<double> d;
-  for (std::size_t i = 0; i < pts.size(); i += stride) {
-    const auto nn = index.nearest(pts[i], 2);
-    if (nn.size() == 2)
-      d.push_back((pts[nn[1]] - pts[i]).norm());
-  }
+  for (std::size_t i = 0; i < pts.size(); i += spacingStride(pts.size()))
+    d.push_back(detail::nearestDistance(grid, pts, i));
   return median(std::move(d));
 }
 
-Points voxelDownsample(const Points& pts, double voxel) {
-  if (voxel <= 0.0)
-    return pts;
-  // Sort the points by voxel (x, then y, then z), stably, and average each run: the same
-  // cells, order and sums as a map of voxels, without a tree node per voxel.
-  const auto keyed = sortedByCell(pts, voxel).keyed;
-  Points out;
-  for (std::size_t i = 0; i < keyed.size();) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    int count = 0;
-    std::size_t j = i;
-    for (; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {
-      sum += pts[keyed[j].second];
-      ++count;
-    }
-    out.push_back(sum / count);
-    i = j;
-  }
-  return out;
-}
-
-std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
-  return floatingMask(pts, nullptr, radius, min_neighbors);
-}
-
-std::vector<char> floatingMask(const Points& pts, const PointIndex* index, double radius,
-                               int min_neighbors) {
+/// floatingMask(); `counting`, when given, is a grid of pts with cells of at least
+/// detail::cellForRadius(radius).
+std::vector<char> floatingMaskWith(const Points& pts, double radius, int min_neighbors,
+                                   const detail::CellKeys* counting) {
   std::vector<char> mask(pts.size(), 0);
   // Cells of edge h = 0.95 radius / sqrt(6): any point of a cell is within the radius of any
   // point of the same cell or of a face-adjacent one (at most h sqrt(6) apart). A cell whose
   // block of seven holds more than min_neighbors points settles all its points without a
-  // search (most points of a dense scan); only the others go to the k-d tree. Same answer.
+  // count (most points of a dense scan); only the others are counted, in a grid of cells of
+  // the radius. Same answer as counting every point with the k-d tree.
   const double cell = 0.95 * radius / std::sqrt(6.0);
-  const CellKeys grid = sortedByCell(pts, cell);
+  const detail::CellKeys grid = detail::sortedByCell(pts, cell);
   const auto& keyed = grid.keyed;
   std::vector<std::uint64_t> keys;
   std::vector<std::size_t> first;  // each cell's first entry in keyed; one past the end last
@@ -441,14 +310,60 @@ std::vector<char> floatingMask(const Points& pts, const PointIndex* index, doubl
   }
   if (open.empty())
     return mask;
-  std::optional<PointIndex> own;
-  if (!index)
-    index = &own.emplace(pts);
+  std::optional<detail::CellKeys> own;
+  if (!counting)
+    counting = &own.emplace(detail::sortedByCell(pts, detail::cellForRadius(radius)));
   parallelFor(static_cast<int>(open.size()), [&](int k) {
     const int i = open[k];
-    mask[i] = index->countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors;
+    mask[i] =
+        detail::countWithin(*counting, pts, pts[i], radius, min_neighbors + 1) <= min_neighbors;
   });
   return mask;
+}
+
+}  // namespace
+
+double medianSpacing(const Points& pts) {
+  if (pts.size() < 2)
+    return 0.0;
+  return spacingFromGrid(pts, detail::sortedByCell(pts, SPACING_CELL));
+}
+
+double medianSpacing(const Points& pts, const PointIndex& index) {
+  if (pts.size() < 2)
+    return 0.0;
+  std::vector<double> d;
+  for (std::size_t i = 0; i < pts.size(); i += spacingStride(pts.size())) {
+    const auto nn = index.nearest(pts[i], 2);
+    if (nn.size() == 2)
+      d.push_back((pts[nn[1]] - pts[i]).norm());
+  }
+  return median(std::move(d));
+}
+
+Points voxelDownsample(const Points& pts, double voxel) {
+  if (voxel <= 0.0)
+    return pts;
+  // Sort the points by voxel (x, then y, then z), stably, and average each run: the same
+  // cells, order and sums as a map of voxels, without a tree node per voxel.
+  const auto keyed = detail::sortedByCell(pts, voxel).keyed;
+  Points out;
+  for (std::size_t i = 0; i < keyed.size();) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    std::size_t j = i;
+    for (; j < keyed.size() && keyed[j].first == keyed[i].first; ++j) {
+      sum += pts[keyed[j].second];
+      ++count;
+    }
+    out.push_back(sum / count);
+    i = j;
+  }
+  return out;
+}
+
+std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors) {
+  return floatingMaskWith(pts, radius, min_neighbors, nullptr);
 }
 
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats) {
@@ -458,15 +373,18 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
   s.after_voxel = out.size();
   if (config.ours_remove_clutter) {
     double radius = config.floating_radius;
-    std::optional<PointIndex> index;
+    // One grid for the spacing and, when the radius stays the configured one, the counts.
+    std::optional<detail::CellKeys> grid;
     if (config.ours_derive_parameters && out.size() >= 2) {
       // Sparse clouds (terrestrial scans of whole trees, a few cm between returns) would lose
       // everything to a fixed radius: scale it with the median nearest-neighbour spacing.
-      radius = std::max(radius, 3.0 * medianSpacing(out, index.emplace(out)));
+      grid.emplace(detail::sortedByCell(out, detail::cellForRadius(radius)));
+      radius = std::max(radius, 3.0 * spacingFromGrid(out, *grid));
     }
     s.floating_radius = radius;
+    const bool reuse = grid && grid->cell >= detail::cellForRadius(radius);
     const auto mask =
-        floatingMask(out, index ? &*index : nullptr, radius, config.floating_min_neighbors);
+        floatingMaskWith(out, radius, config.floating_min_neighbors, reuse ? &*grid : nullptr);
 
     Points kept;
     for (std::size_t i = 0; i < out.size(); ++i) {

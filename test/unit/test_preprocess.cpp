@@ -53,12 +53,31 @@ TEST(FloatingMask, SameAnswerAsABruteForceCount) {
         EXPECT_EQ(mismatches, 0) << "radius " << radius << " min " << min_neighbors;
         EXPECT_GT(floating, 0);
         EXPECT_LT(floating, static_cast<int>(pts.size()));
-        // With an index of the same points: the same mask.
+        // The k-d tree's single-precision count, to the last point.
         const PointIndex index(pts);
-        EXPECT_EQ(floatingMask(pts, &index, radius, min_neighbors), mask);
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          ASSERT_EQ(static_cast<bool>(mask[i]),
+                    index.countWithin(pts[i], radius, min_neighbors + 1) <= min_neighbors)
+              << "point " << i << " radius " << radius << " min " << min_neighbors;
+        }
       }
     }
   }
+}
+
+TEST(MedianSpacing, GridSearchFindsTheIndexsNeighbours) {
+  // A dense scan, and a sparse one whose neighbours lie several grid cells away.
+  Rng rng(12);
+  Points sparse;
+  for (int i = 0; i < 3000; ++i)
+    sparse.emplace_back(rng.uniform(-1.0, 1.0), rng.uniform(5.0, 6.0), rng.uniform(0.0, 0.4));
+  for (const Points& pts : {mixedCloud(5), sparse}) {
+    const double spacing = medianSpacing(pts);
+    EXPECT_DOUBLE_EQ(spacing, medianSpacing(pts, PointIndex(pts)));
+    EXPECT_GT(spacing, 0.0);
+  }
+  EXPECT_GT(medianSpacing(sparse), 0.02) << "the sparse cloud tests the widening search";
+  EXPECT_EQ(medianSpacing(Points{{1, 2, 3}}), 0.0);
 }
 
 TEST(VoxelDownsample, OneMeanPerOccupiedCellInCellOrder) {

@@ -19,7 +19,8 @@ struct PreprocessStats {
 
 class PointIndex;
 
-/// @brief Median distance from a point to its nearest neighbour (on a sample of the points).
+/// @brief Median distance from a point to its nearest neighbour (on a sample of the points;
+/// neighbours chosen in single precision, as PointIndex does).
 double medianSpacing(const Points& pts);
 
 /// @brief medianSpacing with an index of pts that already exists.
@@ -29,12 +30,9 @@ double medianSpacing(const Points& pts, const PointIndex& index);
 /// deterministic order (sorted by voxel key).
 Points voxelDownsample(const Points& pts, double voxel);
 
-/// @brief Points with fewer than min_neighbors others within radius: floating pixels.
+/// @brief Points with fewer than min_neighbors others within radius (single-precision
+/// distances, as PointIndex measures them): floating pixels.
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors);
-
-/// @brief floatingMask with an index of pts that already exists (nullptr: built if needed).
-std::vector<char> floatingMask(const Points& pts, const PointIndex* index, double radius,
-                               int min_neighbors);
 
 /// @brief Downsample and, with config.ours_remove_clutter, drop floating pixels, the ground
 /// plane and trellis wires (long straight thin near-horizontal runs).
