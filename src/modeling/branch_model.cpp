@@ -45,6 +45,13 @@ constexpr double DUPLICATE_MAX_ANGLE = 25.0 * DEG;
 constexpr double DUPLICATE_ATTACHMENT_GAP = 0.06;  // m
 constexpr double DUPLICATE_LINE_GAP = 0.02;        // m
 constexpr double DUPLICATE_REACH = 0.4;            // m
+// A curved branch (a steep scaffold) fitted twice: one fit's centre inside the other's tube,
+// within DUPLICATE_TUBE_RADIUS (or its radius) of its axis and DUPLICATE_TUBE_MARGIN of its
+// ends, the pieces' axes within DUPLICATE_CURVED_ANGLE. The branch opposite across the trunk
+// lies on the axis line too, but a trunk's width beyond the ends.
+constexpr double DUPLICATE_CURVED_ANGLE = 45.0 * DEG;
+constexpr double DUPLICATE_TUBE_RADIUS = 0.03;  // m
+constexpr double DUPLICATE_TUBE_MARGIN = 0.07;  // m
 
 /// Where a point sits relative to the trunk model.
 struct TrunkCoords {
@@ -158,6 +165,18 @@ void removeMarked(std::vector<BranchFit>& branches, const std::vector<char>& dro
 }
 
 }  // namespace
+
+bool curvedPieces(const BranchFit& a, const BranchFit& b) {
+  const Cylinder &ca = a.cylinder, &cb = b.cylinder;
+  const double angle = std::acos(std::clamp(ca.axis.dot(cb.axis), -1.0, 1.0));
+  if (angle >= DUPLICATE_CURVED_ANGLE)
+    return false;
+  const auto inTube = [](const Cylinder& c, const Eigen::Vector3d& p) {
+    return std::abs((p - c.center).dot(c.axis)) <= 0.5 * c.length + DUPLICATE_TUBE_MARGIN &&
+           axisDistance(c, p) <= std::max(DUPLICATE_TUBE_RADIUS, c.radius);
+  };
+  return inTube(ca, cb.center) || inTube(cb, ca.center);
+}
 
 bool sameBranch(const BranchFit& a, const BranchFit& b) {
   const Cylinder &ca = a.cylinder, &cb = b.cylinder;
@@ -568,11 +587,15 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
       for (std::size_t k = i + 1; k < branches.size(); ++k) {
         if (drop[i] || drop[k])
           continue;
-        if (!sameBranch(branches[i], branches[k]))
-          continue;
         const auto& a = branches[i];
         const auto& b = branches[k];
-        const bool keep_a = a.reaches_surface != b.reaches_surface
+        // Two pieces of a curved branch: the longer one's axis is the better determined (the
+        // other piece, whichever reaches the trunk, is short and bent away from the branch).
+        const bool curved = config.branch_merge_curved && curvedPieces(a, b);
+        if (!curved && !sameBranch(a, b))
+          continue;
+        const bool keep_a = curved ? a.cylinder.length >= b.cylinder.length
+                            : a.reaches_surface != b.reaches_surface
                                 ? a.reaches_surface
                                 : a.inliers.size() >= b.inliers.size();
         drop[keep_a ? k : i] = 1;

@@ -71,6 +71,7 @@ const std::map<std::string, Setter>& setters() {
       {"trunk_taper_profile", setter(&C::trunk_taper_profile)},
       {"branch_ray_split", setter(&C::branch_ray_split)},
       {"branch_keep_cut_off", setter(&C::branch_keep_cut_off)},
+      {"branch_merge_curved", setter(&C::branch_merge_curved)},
       {"branch_ray_split_min_noise", setter(&C::branch_ray_split_min_noise)},
       {"branch_min_relative_points", setter(&C::branch_min_relative_points)},
       {"branch_cluster_tolerance", setter(&C::branch_cluster_tolerance)},
@@ -155,6 +156,7 @@ ModelerConfig ModelerConfig::paper() {
   c.trunk_taper_profile = false;
   c.branch_ray_split = false;
   c.branch_keep_cut_off = false;
+  c.branch_merge_curved = false;
   c.branch_min_relative_points = 0.0;
   return c;
 }

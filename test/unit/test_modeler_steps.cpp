@@ -530,6 +530,40 @@ TEST(BranchModel, PiecesOfOneSteepBranchAreOneBranch) {
   EXPECT_FALSE(sameBranch(near, fit(base + 1.12 * up, up, 0.018, {0, 0, 1.70})));
 }
 
+TEST(BranchModel, PiecesOfOneCurvedScaffoldAreOneBranch) {
+  const auto fit = [](const Eigen::Vector3d& centre, const Eigen::Vector3d& axis, double radius,
+                      double length) {
+    BranchFit f;
+    f.cylinder.center = centre;
+    f.cylinder.axis = axis.normalized();
+    f.cylinder.radius = radius;
+    f.cylinder.length = length;
+    return f;
+  };
+  const auto turned = [](const Eigen::Vector3d& v, double deg) {
+    return Eigen::Vector3d(Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) * v);
+  };
+  // A 3 cm scaffold leaving a 5 cm trunk at 30 deg, bending up: a 24 cm fit of its outer part
+  // and a 12 cm fit of its base whose axis is 36 deg off, its centre on the outer fit's axis
+  // 3 cm nearer the trunk than that fit's inner end.
+  const Eigen::Vector3d out(std::cos(30.0 * M_PI / 180.0), 0.0, std::sin(30.0 * M_PI / 180.0));
+  const Eigen::Vector3d base(0.05, 0.0, 1.5);
+  const BranchFit outer = fit(base + 0.27 * out, out, 0.014, 0.24);
+  const BranchFit inner = fit(base + 0.12 * out, turned(out, 36.0), 0.014, 0.12);
+  EXPECT_TRUE(curvedPieces(outer, inner));
+  EXPECT_TRUE(curvedPieces(inner, outer));
+  EXPECT_FALSE(sameBranch(outer, inner)) << "36 deg apart: not one straight branch";
+  // The branch opposite across the trunk, pointing the other way: two branches.
+  const BranchFit opposite =
+      fit(base - 0.1 * Eigen::Vector3d::UnitX() - 0.2 * out, -out, 0.014, 0.24);
+  EXPECT_FALSE(curvedPieces(outer, opposite));
+  // A branch crossing 60 deg away through the same place: two branches.
+  EXPECT_FALSE(curvedPieces(outer, fit(base + 0.27 * out, turned(out, 60.0), 0.014, 0.24)));
+  // Parallel, 5 cm to the side: two branches.
+  EXPECT_FALSE(
+      curvedPieces(outer, fit(base + 0.27 * out + Eigen::Vector3d(0, 0.05, 0), out, 0.014, 0.24)));
+}
+
 TEST(TrunkModel, TooLittleIsNoTrunk) {
   ModelerConfig config;
   try {

@@ -41,6 +41,12 @@ struct RejectedBranch {
 /// within 0.4 m.
 bool sameBranch(const BranchFit& a, const BranchFit& b);
 
+/// @brief Whether two detections are pieces of one curved branch (a steep scaffold bending
+/// up): one's centre inside the other's tube (within 3 cm or its radius of the axis, and 7 cm
+/// of its ends) and their axes within 45 deg. The branch opposite across the trunk lies on the
+/// axis line as well, but a trunk's width beyond the ends.
+bool curvedPieces(const BranchFit& a, const BranchFit& b);
+
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
 /// config.ours_branch_shell, every point of the cloud in a shell around the trunk cylinders.

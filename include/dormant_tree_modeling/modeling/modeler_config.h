@@ -105,6 +105,10 @@ struct ModelerConfig {
   /// accepted branch: at centimetre noise a branch crossing it near the trunk takes its near
   /// part out with its own points. Off: such fits are turned down ("not at the surface").
   bool branch_keep_cut_off = true;
+  /// Two detections that are pieces of one curved branch (curvedPieces(): one centre inside
+  /// the other's tube, axes within 45 deg) are one; the longer is kept. Off: only duplicates
+  /// within 25 deg of each other are merged (sameBranch()).
+  bool branch_merge_curved = true;
   /// A detection with fewer inliers than this fraction of the median over the tree's
   /// detections is dropped (a shoot on a primary, a neighbour's branch tip, a streak of mixed
   /// pixels); 0: off. Needs at least 4 detections.
