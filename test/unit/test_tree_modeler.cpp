@@ -2,6 +2,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -87,6 +88,30 @@ TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
   EXPECT_LE(score.trunk_mae, 0.004) << evaluation::formatTable({score});
   EXPECT_GE(score.coverage, 0.85) << evaluation::formatTable({score});
   EXPECT_EQ(result.classes.size(), result.points.size());
+  // The trunk diameter where each branch leaves (the pruning ratio's denominator) against the
+  // truth's at that height.
+  double base = std::numeric_limits<double>::infinity();
+  for (const auto& c : result.model.trunk)
+    base = std::min(base, c.center.z() - 0.5 * c.length * std::abs(c.axis.z()));
+  const auto& truth_trunk = scan.truth.trunk;
+  const auto trueDiameterAt = [&](double z) {
+    const auto& p = truth_trunk.points;
+    for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+      if (z <= p[k + 1].z()) {
+        const double f = std::clamp((z - p[k].z()) / (p[k + 1].z() - p[k].z()), 0.0, 1.0);
+        return (1.0 - f) * truth_trunk.diameters[k] + f * truth_trunk.diameters[k + 1];
+      }
+    }
+    return truth_trunk.diameters.back();
+  };
+  double trunk_error = 0.0;
+  for (const auto& b : result.model.primary_branches) {
+    trunk_error += std::abs(b.measurement.trunk_diameter -
+                            trueDiameterAt(base + b.measurement.attachment_height));
+  }
+  trunk_error /= std::max<std::size_t>(1, result.model.primary_branches.size());
+  RecordProperty("trunk_diameter_at_branches_mae_mm", std::to_string(1000 * trunk_error));
+  EXPECT_LE(trunk_error, 0.003);
   // Measurements are consistent with the cylinders.
   for (const auto& b : result.model.primary_branches) {
     EXPECT_NEAR(b.measurement.diameter_ratio, b.cylinder.diameter / b.measurement.trunk_diameter,
