@@ -48,7 +48,7 @@ constexpr double DUPLICATE_REACH = 0.4;            // m
 // A curved branch (a steep scaffold) fitted twice: one fit's centre inside the other's tube,
 // within DUPLICATE_TUBE_RADIUS (or its radius) of its axis and DUPLICATE_TUBE_MARGIN of its
 // ends, the pieces' axes within DUPLICATE_CURVED_ANGLE. The branch opposite across the trunk
-// lies on the axis line too, but a trunk's width beyond the ends.
+// lies on the axis line too, but points the other way and lies a trunk's width beyond the ends.
 constexpr double DUPLICATE_CURVED_ANGLE = 45.0 * DEG;
 constexpr double DUPLICATE_TUBE_RADIUS = 0.03;  // m
 constexpr double DUPLICATE_TUBE_MARGIN = 0.07;  // m
