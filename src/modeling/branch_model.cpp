@@ -63,15 +63,7 @@ struct TrunkCoords {
 TrunkCoords locate(const TrunkModel& trunk, const Eigen::Vector3d& p) {
   TrunkCoords c;
   c.s = trunk.centerline.project(p);
-  double best = 1e300;
-  for (std::size_t i = 0; i < trunk.cylinder_ranges.size(); ++i) {
-    const auto& r = trunk.cylinder_ranges[i];
-    const double gap = c.s < r.first ? r.first - c.s : (c.s > r.second ? c.s - r.second : 0.0);
-    if (gap < best) {
-      best = gap;
-      c.segment = static_cast<int>(i);
-    }
-  }
+  c.segment = trunk.cylinderAt(c.s);
   if (c.segment >= 0)
     c.distance = axisDistance(trunk.cylinders[c.segment], p);
   return c;

@@ -66,10 +66,8 @@ CellKeys sortedByCell(const Points& pts, double cell) {
   out.lo = lo;
   out.hi = hi;
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    std::uint64_t key = 0;
-    for (int a = 0; a < 3; ++a)
-      key += static_cast<std::uint64_t>(cellOf(pts[i](a)) - lo[a] + 1) * out.unit[a];
-    out.keyed[i] = {key, static_cast<int>(i)};
+    const Eigen::Vector3d& p = pts[i];
+    out.keyed[i] = {out.key(cellOf(p.x()), cellOf(p.y()), cellOf(p.z())), static_cast<int>(i)};
   }
   radixSortByKey(out.keyed, bits[0] + bits[1] + bits[2]);
   return out;

@@ -27,6 +27,13 @@ struct CellKeys {
   std::array<long, 3> lo{};                          ///< lowest occupied cell per axis
   std::array<long, 3> hi{};                          ///< highest occupied cell per axis
   double cell = 0.0;                                 ///< edge (m)
+
+  /// @brief Key of cell (x, y, z), each from lo - 1 to hi + 1 on its axis.
+  std::uint64_t key(long x, long y, long z) const {
+    return static_cast<std::uint64_t>(x - lo[0] + 1) * unit[0] +
+           static_cast<std::uint64_t>(y - lo[1] + 1) * unit[1] +
+           static_cast<std::uint64_t>(z - lo[2] + 1) * unit[2];
+  }
 };
 
 /// @brief Every point's grid cell (edge `cell`, m) with its index, sorted by cell and then by
@@ -44,19 +51,13 @@ bool forEachInCube(const CellKeys& grid, const Eigen::Vector3d& p, long k, const
   std::array<long, 3> c;
   for (int a = 0; a < 3; ++a)
     c[a] = static_cast<long>(std::floor(p(a) / grid.cell));
-  // Cells are numbered from one below the lowest occupied: keys exist for lo - 1 .. hi + 1.
-  const auto key = [&](long x, long y, long z) {
-    return static_cast<std::uint64_t>(x - grid.lo[0] + 1) * grid.unit[0] +
-           static_cast<std::uint64_t>(y - grid.lo[1] + 1) * grid.unit[1] +
-           static_cast<std::uint64_t>(z - grid.lo[2] + 1) * grid.unit[2];
-  };
   const long z_lo = std::max(c[2] - k, grid.lo[2]), z_hi = std::min(c[2] + k, grid.hi[2]);
   if (z_lo > z_hi)
     return true;
   for (long x = std::max(c[0] - k, grid.lo[0]); x <= std::min(c[0] + k, grid.hi[0]); ++x) {
     for (long y = std::max(c[1] - k, grid.lo[1]); y <= std::min(c[1] + k, grid.hi[1]); ++y) {
       // z is the key's lowest part: a column of cells is one run of keys.
-      const std::uint64_t first = key(x, y, z_lo), last = key(x, y, z_hi);
+      const std::uint64_t first = grid.key(x, y, z_lo), last = grid.key(x, y, z_hi);
       auto it = std::lower_bound(grid.keyed.begin(), grid.keyed.end(),
                                  std::make_pair(first, std::numeric_limits<int>::min()));
       for (; it != grid.keyed.end() && it->first <= last; ++it) {

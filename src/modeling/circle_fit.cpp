@@ -100,8 +100,8 @@ std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions
       continue;
     // Inliers from squared distances (a root only for the inliers' cost); a hypothesis that can
     // no longer reach the best count is left early. Same choice as scoring every point.
-    const double inner = std::max(0.0, c->radius - o.threshold);
-    const double inner2 = c->radius > o.threshold ? inner * inner : -1.0;
+    const double inner = c->radius - o.threshold;
+    const double inner2 = inner > 0.0 ? inner * inner : -1.0;
     const double outer2 = (c->radius + o.threshold) * (c->radius + o.threshold);
     int count = 0;
     double cost = 0.0;

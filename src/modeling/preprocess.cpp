@@ -122,7 +122,8 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
   // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points,
   // against a 1 cm grid of the cloud: the shape of a 10 cm ball needs no finer sampling. The
   // ball is gathered from the 27 cells of a 10 cm grid around the point (cheaper than a k-d
-  // tree for 20000 balls of hundreds of points each; the same points).
+  // tree for 20000 balls of hundreds of points each; the same ball, its edge measured in double
+  // precision where the single-precision tree rounded).
   const Points coarse = voxelDownsample(pts, WIRE_TEST_VOXEL);
   const detail::CellKeys grid = detail::sortedByCell(coarse, WIRE_NEIGHBOURHOOD);
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);

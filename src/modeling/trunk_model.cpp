@@ -329,6 +329,38 @@ double TrunkModel::baseZ() const {
   return z;
 }
 
+int TrunkModel::cylinderAt(double s) const {
+  int best = -1;
+  double best_gap = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < cylinder_ranges.size(); ++i) {
+    const auto [a, b] = cylinder_ranges[i];
+    const double gap = s < a ? a - s : (s > b ? s - b : 0.0);
+    if (gap < best_gap) {
+      best_gap = gap;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+double TrunkModel::diameterAt(double s) const {
+  const auto middle = [&](std::size_t i) {
+    return 0.5 * (cylinder_ranges[i].first + cylinder_ranges[i].second);
+  };
+  const std::size_t n = cylinder_ranges.size();
+  if (n == 0)
+    return 0.0;
+  if (s <= middle(0))
+    return 2.0 * cylinders.front().radius;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    if (s <= middle(i + 1)) {
+      const double f = (s - middle(i)) / std::max(middle(i + 1) - middle(i), 1e-9);
+      return 2.0 * ((1.0 - f) * cylinders[i].radius + f * cylinders[i + 1].radius);
+    }
+  }
+  return 2.0 * cylinders.back().radius;
+}
+
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
                         const ModelerConfig& config, int max_misses, bool trust_radius) {

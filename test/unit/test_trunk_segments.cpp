@@ -91,6 +91,26 @@ TEST(TrunkSegments, ALengthBelowTwoShortestSegmentsIsRefused) {
   EXPECT_NO_THROW(config.validate());
 }
 
+TEST(TrunkSegments, DiameterAlongTheTrunkFollowsTheTaper) {
+  // Three 1 m segments of radius 5, 4 and 3 cm.
+  TrunkModel trunk;
+  EXPECT_EQ(trunk.cylinderAt(0.5), -1);
+  EXPECT_EQ(trunk.diameterAt(0.5), 0.0);
+  for (int i = 0; i < 3; ++i) {
+    Cylinder c;
+    c.radius = 0.05 - 0.01 * i;
+    trunk.cylinders.push_back(c);
+    trunk.cylinder_ranges.emplace_back(i, i + 1.0);
+  }
+  EXPECT_EQ(trunk.cylinderAt(-0.5), 0);
+  EXPECT_EQ(trunk.cylinderAt(1.5), 1);
+  EXPECT_EQ(trunk.cylinderAt(9.0), 2);
+  EXPECT_DOUBLE_EQ(trunk.diameterAt(0.2), 0.10) << "below the first middle: its diameter";
+  EXPECT_DOUBLE_EQ(trunk.diameterAt(1.0), 0.09) << "halfway between two middles";
+  EXPECT_DOUBLE_EQ(trunk.diameterAt(1.75), 0.075);
+  EXPECT_DOUBLE_EQ(trunk.diameterAt(9.0), 0.06) << "beyond the last middle: its diameter";
+}
+
 }  // namespace
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

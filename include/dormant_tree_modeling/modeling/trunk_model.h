@@ -69,6 +69,13 @@ struct TrunkModel {
   /// @brief Height of the trunk's base: the lowest end of its cylinders (m); heights on the
   /// tree (attachment heights, the lowest primary) count from here.
   double baseZ() const;
+  /// @brief Index of the cylinder whose arc-length range holds s, the nearest one when s falls
+  /// between or beyond them; -1 without cylinders.
+  int cylinderAt(double s) const;
+  /// @brief Trunk diameter at arc length s (m): linear between the cylinders' middles (each
+  /// cylinder's radius is its mean over a taper), the end cylinders' beyond their middles; 0
+  /// without cylinders.
+  double diameterAt(double s) const;
 };
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
