@@ -1,5 +1,6 @@
 #include "dormant_tree_modeling/lms111/cola.h"
 
+#include <cstdio>
 #include <cstring>
 
 #include "dormant_tree_modeling/common/error.h"
@@ -163,25 +164,72 @@ std::optional<std::int64_t> parseColaNumber(const std::string& t) {
 
 std::string describeSfaError(int code) {
   switch (code) {
-    case 1:
+    case SFA_ACCESS_DENIED:
       return "access denied (log in with SetAccessMode first)";
-    case 2:
+    case SFA_UNKNOWN_METHOD:
       return "unknown method";
-    case 3:
+    case SFA_UNKNOWN_VARIABLE:
       return "unknown variable";
-    case 4:
+    case SFA_LOCAL_CONDITION:
       return "local condition failed (the device is not in a state that allows this)";
-    case 5:
+    case SFA_INVALID_DATA:
       return "invalid data";
-    case 8:
+    case SFA_UNKNOWN_ERROR:
+      return "unknown error";
+    case SFA_BUFFER_OVERFLOW:
+      return "buffer overflow (more parameters than the telegram's layout holds)";
+    case SFA_BUFFER_UNDERFLOW:
       return "buffer underflow (too few parameters)";
-    case 10:
+    case SFA_UNKNOWN_TYPE:
+      return "unknown type";
+    case SFA_WRITE_ACCESS_DENIED:
       return "write access denied";
-    case 11:
+    case SFA_UNKNOWN_NAMESERVER_COMMAND:
       return "unknown command";
+    case SFA_UNKNOWN_COLA_COMMAND:
+      return "unknown CoLa command";
+    case SFA_SERVER_BUSY:
+      return "server busy";
+    case SFA_FLEX_OUT_OF_BOUNDS:
+      return "flexible array out of bounds";
+    case SFA_UNKNOWN_EVENT:
+      return "unknown event";
+    case SFA_COLA_A_VALUE_OVERFLOW:
+      return "CoLa-A value overflow (a value wider than its field)";
+    case SFA_COLA_A_INVALID_CHARACTER:
+      return "CoLa-A invalid character";
     default:
       return "unknown error code " + std::to_string(code);
   }
+}
+
+std::string replyTypeOf(const std::string& type) {
+  if (type == "sRN")
+    return "sRA";
+  if (type == "sWN")
+    return "sWA";
+  if (type == "sMN")
+    return "sAN";
+  if (type == "sEN")
+    return "sEA";
+  return type;
+}
+
+std::string printableBytes(const std::string& bytes, std::size_t max_bytes) {
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size() && i < max_bytes; ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if (c >= 0x20 && c < 0x7F && c != '\\') {
+      out.push_back(static_cast<char>(c));
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02X", c);
+      out += buf;
+    }
+  }
+  if (bytes.size() > max_bytes)
+    out += "...";
+  return out;
 }
 
 std::string deviceStateName(int state) {

@@ -9,14 +9,10 @@ namespace lms111 {
 
 namespace {
 
-// sFA codes (docs/hardware.md).
-constexpr int SFA_ACCESS_DENIED = 1;
-constexpr int SFA_UNKNOWN_METHOD = 2;
-constexpr int SFA_UNKNOWN_VARIABLE = 3;
-constexpr int SFA_LOCAL_CONDITION = 4;
-constexpr int SFA_INVALID_DATA = 5;
-constexpr int SFA_BUFFER_UNDERFLOW = 8;
-constexpr int SFA_UNKNOWN_COMMAND = 11;
+// The request names the device does not know at all answer this (SOPAS "unknown command").
+constexpr int SFA_UNKNOWN_COMMAND = SFA_UNKNOWN_NAMESERVER_COMMAND;
+// The one echo the emulated device measures (output channel mask of LMDscandatacfg).
+constexpr std::uint64_t FIRST_ECHO = 1;
 
 // mLMPsetscancfg result codes.
 constexpr int SCANCFG_OK = 0;
@@ -33,6 +29,18 @@ struct SfaReply {
   int code;
 };
 
+// A request with more fields than its layout holds is refused as the device does.
+void expectEnd(const FieldReader& r) {
+  if (!r.atEnd())
+    throw SfaReply{SFA_BUFFER_OVERFLOW};
+}
+
+// A field the layout reserves (the high byte of the output channel and of the encoder setting).
+void expectZero(std::uint64_t value) {
+  if (value != 0)
+    throw SfaReply{SFA_INVALID_DATA};
+}
+
 bool validPair(std::uint32_t frequency, std::uint32_t resolution) {
   // The LMS111 pairs 25 Hz with 0.25 deg and 50 Hz with 0.5 deg.
   return (frequency == 2500 && resolution == 2500) || (frequency == 5000 && resolution == 5000);
@@ -43,10 +51,35 @@ bool validArea(std::int32_t start, std::int32_t stop, std::uint32_t resolution) 
          (stop - start) % static_cast<std::int32_t>(resolution) == 0;
 }
 
-void writeScanArea(FieldWriter& w, const DeviceScanConfig& c) {
+void writeScanArea(FieldWriter& w, const DeviceScanConfig& c, std::int32_t angle_error = 0) {
   w.unsignedValue(c.resolution);
-  w.signedValue(c.start_angle);
-  w.signedValue(c.stop_angle);
+  w.signedValue(c.start_angle + angle_error);
+  w.signedValue(c.stop_angle - angle_error);
+}
+
+// sWN LMDscandatacfg as the device lays it out: output channel (echo mask, reserved), remission,
+// remission resolution, unit, encoder (setting, reserved), position, device name, comment,
+// time, output interval (16 bit); the LMS111 has no position block and no encoder here.
+DataOutputConfig readDataOutputConfig(FieldReader& r) {
+  const auto echo_mask = r.unsignedValue("output channel", 8);
+  expectZero(r.unsignedValue("output channel (reserved)", 8));
+  DataOutputConfig o;
+  o.rssi = r.unsignedValue("remission", 8) != 0;
+  const auto resolution = r.unsignedValue("remission resolution", 8);
+  o.rssi_16bit = resolution == 1;
+  const auto unit = r.unsignedValue("unit", 8);
+  const auto encoder = r.unsignedValue("encoder", 8);
+  expectZero(r.unsignedValue("encoder (reserved)", 8));
+  const auto position = r.unsignedValue("position", 8);
+  o.device_name = r.unsignedValue("device name", 8) != 0;
+  o.comment = r.unsignedValue("comment", 8) != 0;
+  o.time_stamp = r.unsignedValue("time", 8) != 0;
+  o.output_interval = static_cast<std::uint16_t>(r.unsignedValue("output interval", 16));
+  expectEnd(r);
+  if (echo_mask != FIRST_ECHO || resolution > 1 || unit != 0 || encoder != 0 || position != 0 ||
+      o.output_interval == 0)
+    throw SfaReply{SFA_INVALID_DATA};
+  return o;
 }
 
 }  // namespace
@@ -116,7 +149,12 @@ std::string EmulatedLms111::reply(const EmulatorSession& session, const std::str
   w->word(name);
   if (fields)
     fields(*w);
-  return w->payload();
+  std::string payload = w->payload();
+  // A real device ends a CoLa-B reply's command words with a space even when no field follows
+  // (`sWA LMDscandatacfg `, `sWA EIHstCola ` in the recorded session).
+  if (session.protocol == Protocol::COLA_B && payload.size() == type.size() + 1 + name.size())
+    payload += ' ';
+  return payload;
 }
 
 std::string EmulatedLms111::sfa(const EmulatorSession& session, int code) const {
@@ -136,27 +174,52 @@ std::vector<std::string> EmulatedLms111::handle(const std::string& payload,
   } catch (const Error&) {
     return {sfa(session, SFA_UNKNOWN_COMMAND)};
   }
+  std::vector<std::string> out;
+  if (auto event = nextEvent(session.protocol))
+    out.push_back(*event);
+  out.push_back(answer(payload, type, name, *reader, session, now_s));
+  return out;
+}
+
+std::optional<std::string> EmulatedLms111::nextEvent(Protocol protocol) {
+  if (!recording_ || recording_->events.empty() || protocol != Protocol::COLA_B)
+    return std::nullopt;
+  return recording_->events[next_event_++ % recording_->events.size()];
+}
+
+std::string EmulatedLms111::answer(const std::string& payload, const std::string& type,
+                                   const std::string& name, FieldReader& reader,
+                                   EmulatorSession& session, double now_s) {
+  const bool recorded = recording_ && session.protocol == Protocol::COLA_B;
+  if (recorded) {
+    const auto size = recording_->request_bytes.find(type + " " + name);
+    if (size != recording_->request_bytes.end() && size->second != payload.size())
+      return sfa(session,
+                 payload.size() > size->second ? SFA_BUFFER_OVERFLOW : SFA_BUFFER_UNDERFLOW);
+  }
   auto fault = faults_.sfa.find(name);
   if (fault != faults_.sfa.end() && fault->second.times != 0) {
     if (fault->second.times > 0)
       --fault->second.times;
-    return {sfa(session, fault->second.code)};
+    return sfa(session, fault->second.code);
   }
   try {
-    const auto r = dispatch(type, name, *reader, session, now_s);
-    if (!r)
-      return {};
-    return {*r};
+    std::string reply = dispatch(type, name, reader, session, now_s);
+    if (recorded) {
+      const auto it = recording_->reply_to.find(payload);
+      if (it != recording_->reply_to.end())
+        reply = it->second;
+    }
+    return reply;
   } catch (const SfaReply& e) {
-    return {sfa(session, e.code)};
+    return sfa(session, e.code);
   } catch (const Error&) {
-    return {sfa(session, SFA_BUFFER_UNDERFLOW)};  // too few or unreadable parameters
+    return sfa(session, SFA_BUFFER_UNDERFLOW);  // too few or unreadable parameters
   }
 }
 
-std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
-                                                    const std::string& name, FieldReader& r,
-                                                    EmulatorSession& session, double now_s) {
+std::string EmulatedLms111::dispatch(const std::string& type, const std::string& name,
+                                     FieldReader& r, EmulatorSession& session, double now_s) {
   auto requireLevel = [&]() {
     if (session.access_level < AUTHORISED_CLIENT_LEVEL)
       throw SfaReply{SFA_ACCESS_DENIED};
@@ -165,6 +228,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
     if (name == "SetAccessMode") {
       const auto level = static_cast<int>(r.unsignedValue("user level", 8));
       const auto password = static_cast<std::uint32_t>(r.unsignedValue("password"));
+      expectEnd(r);
       const bool ok = level == AUTHORISED_CLIENT_LEVEL && password == AUTHORISED_CLIENT_PASSWORD;
       if (ok)
         session.access_level = level;
@@ -178,6 +242,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
       c.resolution = static_cast<std::uint32_t>(r.unsignedValue("angular resolution"));
       c.start_angle = r.signedValue("start angle");
       c.stop_angle = r.signedValue("stop angle");
+      expectEnd(r);
       const bool freq_ok = c.frequency == 2500 || c.frequency == 5000;
       const bool res_ok = c.resolution == 2500 || c.resolution == 5000;
       int result = SCANCFG_OK;
@@ -199,6 +264,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
       });
     }
     if (name == "LMCstartmeas" || name == "LMCstopmeas") {
+      expectEnd(r);
       requireLevel();
       const bool was_measuring = measuring_;
       measuring_ = name == "LMCstartmeas";
@@ -207,6 +273,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
       return reply(session, "sAN", name, [](FieldWriter& w) { w.unsignedValue(0, 8); });
     }
     if (name == "Run") {
+      expectEnd(r);
       // Leaves the authorised level and applies the configuration: the device re-initialises.
       const bool changed =
           pending_.frequency != active_.frequency || pending_.resolution != active_.resolution ||
@@ -220,6 +287,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
     throw SfaReply{SFA_UNKNOWN_METHOD};
   }
   if (type == "sRN") {
+    expectEnd(r);
     if (name == "STlms") {
       return reply(session, "sRA", name, [&](FieldWriter& w) {
         w.unsignedValue(static_cast<std::uint64_t>(state(now_s)), 16);
@@ -228,6 +296,8 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
         w.characters("00:00:00");
         w.unsignedValue(10, 16);
         w.characters("01.01.2026");
+        for (int led = 0; led < 3; ++led)
+          w.unsignedValue(0, 8);  // LED 1..3 off
       });
     }
     if (name == "LMPscancfg") {
@@ -240,7 +310,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
     if (name == "LMPoutputRange") {
       return reply(session, "sRA", name, [&](FieldWriter& w) {
         w.unsignedValue(1, 16);
-        writeScanArea(w, active_);
+        writeScanArea(w, active_, config_.reported_angle_error);
       });
     }
     if (name == "DeviceIdent") {
@@ -271,6 +341,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
       const auto resolution = static_cast<std::uint32_t>(r.unsignedValue("angular resolution"));
       c.start_angle = r.signedValue("start angle");
       c.stop_angle = r.signedValue("stop angle");
+      expectEnd(r);
       if (resolution != c.resolution || !validArea(c.start_angle, c.stop_angle, c.resolution))
         throw SfaReply{SFA_INVALID_DATA};
       pending_ = c;
@@ -278,20 +349,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
     }
     if (name == "LMDscandatacfg") {
       requireLevel();
-      DataOutputConfig o;
-      const auto channel = r.unsignedValue("output channel", 16);
-      o.rssi = r.unsignedValue("remission", 8) != 0;
-      const auto resolution = r.unsignedValue("remission resolution", 8);
-      r.unsignedValue("unit", 8);
-      r.unsignedValue("encoder", 16);
-      if (r.unsignedValue("position", 8) != 0)
-        throw SfaReply{SFA_INVALID_DATA};  // the LMS111 has no position block to send
-      o.device_name = r.unsignedValue("device name", 8) != 0;
-      o.comment = r.unsignedValue("comment", 8) != 0;
-      o.time_stamp = r.unsignedValue("time", 8) != 0;
-      o.output_interval = static_cast<std::uint16_t>(r.unsignedValue("output interval", 16));
-      if (channel != 1 || resolution > 1 || o.output_interval == 0)
-        throw SfaReply{SFA_INVALID_DATA};
+      const DataOutputConfig o = readDataOutputConfig(r);
       output_ = o;
       return reply(session, "sWA", name);
     }
@@ -300,6 +358,7 @@ std::optional<std::string> EmulatedLms111::dispatch(const std::string& type,
   if (type == "sEN") {
     if (name == "LMDscandata") {
       const auto on = r.unsignedValue("on/off", 8);
+      expectEnd(r);
       if (on > 1)
         throw SfaReply{SFA_INVALID_DATA};
       session.streaming = on == 1;
@@ -350,7 +409,11 @@ std::optional<ScanTelegram> EmulatedLms111::nextScan(double now_s) {
     ScanChannel rssi = s.channels16.front();
     rssi.name = "RSSI1";
     rssi.values = std::move(content.rssi);
-    s.channels16.push_back(std::move(rssi));
+    if (!output_.rssi_16bit) {
+      for (auto& v : rssi.values)
+        v = std::min<std::uint16_t>(v, 0xFF);
+    }
+    (output_.rssi_16bit ? s.channels16 : s.channels8).push_back(std::move(rssi));
   }
   if (output_.device_name)
     s.device_name = config_.device_name;

@@ -7,16 +7,19 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/tcp_connection.h"
 #include "dormant_tree_modeling/lms111/cola_fields.h"
-#include "dormant_tree_modeling/lms111/device_emulator.h"
+#include "dormant_tree_modeling/lms111/requests.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {
 
 namespace {
 
-constexpr double STATE_POLL_S = 0.1;
 constexpr double STOP_REPLY_TIMEOUT_S = 0.5;
 constexpr double MIN_SCAN_TIMEOUT_S = 0.2;
+// Real devices report their angles a few 1/10000 deg off the nominal (an LMS111 answers its
+// range as -44.9997 ... 224.9997 deg): scans are the configured ones within this, a small
+// fraction of the finest step (0.25 deg).
+constexpr std::int32_t ANGLE_TOLERANCE_UNITS = 100;
 
 double steadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -98,38 +101,35 @@ class Lms111Driver::Session {
 
   void connect() { connection_.connect(c_.host, c_.port, c_.connect_timeout_s); }
 
-  // Sends a request, waits for its reply (type + name) and hands back a reader positioned at
-  // the reply's arguments. Scan telegrams that arrive meanwhile are ignored.
-  std::unique_ptr<FieldReader> request(const std::string& type, const std::string& name,
-                                       const std::function<void(FieldWriter&)>& args = {},
-                                       double timeout_s = -1.0) {
-    const auto w = makeWriter(c_.protocol);
-    w->word(type);
-    w->word(name);
-    if (args)
-      args(*w);
+  // Sends a request payload, waits for its reply (the request's reply type and name) and hands
+  // back a reader positioned at the reply's arguments. Events (`sSN`: scans still in flight,
+  // input/output states, field records a previous client subscribed) are passed over.
+  std::unique_ptr<FieldReader> request(const std::string& payload, double timeout_s = -1.0) {
+    const auto words = makeReader(c_.protocol, payload);
+    const std::string type = words->word("command type");
+    const std::string name = words->word("command");
     const double timeout = timeout_s > 0 ? timeout_s : c_.reply_timeout_s;
-    connection_.send(frame(c_.protocol, w->payload()), timeout);
-    const std::string expected = replyType(type);
+    connection_.send(frame(c_.protocol, payload), timeout);
+    const std::string expected = replyTypeOf(type);
     const double deadline = steadySeconds() + timeout;
     for (;;) {
-      const auto payload = nextPayload(deadline - steadySeconds());
-      if (!payload) {
+      const auto reply = nextPayload(deadline - steadySeconds());
+      if (!reply) {
         throw Error(ErrorCode::IO_FAILURE, "no reply to " + type + " " + name + " within " +
                                                std::to_string(timeout) + " s");
       }
-      auto r = makeReader(c_.protocol, *payload);
+      auto r = makeReader(c_.protocol, *reply);
       const std::string got_type = r->word("reply type");
       if (got_type == "sFA")
         throw DeviceRefusal(type + " " + name,
                             static_cast<int>(r->unsignedValue("error code", 16)));
       if (got_type == "sSN")
-        continue;  // a scan still in flight from an earlier stream
+        continue;
       const std::string got_name = r->word("reply name");
       if (got_type == expected && got_name == name)
         return r;
-      d_.log(1, "ignored an unexpected reply '" + got_type + " " + got_name + "' to " + type + " " +
-                    name);
+      d_.log(1, "ignored an unexpected reply '" + printableBytes(got_type + " " + got_name) +
+                    "' to " + type + " " + name);
     }
   }
 
@@ -155,45 +155,38 @@ class Lms111Driver::Session {
   }
 
   void configure() {
-    {
-      auto r = request("sRN", "DeviceIdent");
-      const auto n = r->unsignedValue("name length", 16);
-      std::string ident = r->characters("name", n);
-      const auto m = r->unsignedValue("version length", 16);
-      ident += " " + r->characters("version", m);
-      std::lock_guard<std::mutex> lock(d_.mutex_);
-      d_.stats_.device_ident = ident;
-    }
-    auto login = request("sMN", "SetAccessMode", [](FieldWriter& w) {
-      w.unsignedValue(AUTHORISED_CLIENT_LEVEL, 8);
-      w.unsignedValue(AUTHORISED_CLIENT_PASSWORD);
-    });
+    readDeviceIdent();
+    auto login = request(loginRequest(c_.protocol));
     if (login->unsignedValue("result", 8) != 1)
       throw Error(ErrorCode::IO_FAILURE, "the device refused the authorised-client login");
     setScanConfig();
-    request("sWN", "LMPoutputRange", [this](FieldWriter& w) {
-      w.unsignedValue(1, 16);
-      w.unsignedValue(c_.resolutionUnits());
-      w.signedValue(c_.startUnits());
-      w.signedValue(c_.stopUnits());
-    });
-    request("sWN", "LMDscandatacfg", [this](FieldWriter& w) {
-      w.unsignedValue(1, 16);               // DIST1
-      w.unsignedValue(c_.rssi ? 1 : 0, 8);  // remission
-      w.unsignedValue(0, 8);                // 8-bit remission values
-      w.unsignedValue(0, 8);                // distances in mm
-      w.unsignedValue(0, 16);               // no encoder
-      w.unsignedValue(0, 8);                // no position block
-      w.unsignedValue(0, 8);                // no device name
-      w.unsignedValue(0, 8);                // no comment
-      w.unsignedValue(0, 8);                // no time block: the µs clock is what we map
-      w.unsignedValue(1, 16);               // every scan
-    });
-    request("sMN", "LMCstartmeas");
-    request("sMN", "Run");
-    waitUntilReady();
+    request(outputRangeRequest(c_.protocol, area()));
+    ScanDataOutput output;
+    output.rssi = c_.rssi;  // no time block: the µs clock is what we map
+    request(scanDataConfigRequest(c_.protocol, output));
+    request(plainRequest(c_.protocol, "sMN", "LMCstartmeas"));
+    // Run leaves the authorised level and applies the configuration.
+    request(plainRequest(c_.protocol, "sMN", "Run"));
     verifyScanConfig();
-    request("sEN", "LMDscandata", [](FieldWriter& w) { w.unsignedValue(1, 8); });
+    request(streamRequest(c_.protocol, true));
+  }
+
+  void readDeviceIdent() {
+    auto r = request(plainRequest(c_.protocol, "sRN", "DeviceIdent"));
+    const auto n = r->unsignedValue("name length", 16);
+    std::string ident = r->characters("name", n);
+    const auto m = r->unsignedValue("version length", 16);
+    ident += " " + r->characters("version", m);
+    std::lock_guard<std::mutex> lock(d_.mutex_);
+    d_.stats_.device_ident = printableBytes(ident);
+  }
+
+  ScanArea area() const {
+    ScanArea a;
+    a.resolution = c_.resolutionUnits();
+    a.start_angle = c_.startUnits();
+    a.stop_angle = c_.stopUnits();
+    return a;
   }
 
   // Some firmware refuses mLMPsetscancfg (sFA 8 or 11) although it already runs the asked
@@ -201,13 +194,7 @@ class Lms111Driver::Session {
   // what the device runs and carry on only if it matches.
   void setScanConfig() {
     try {
-      auto r = request("sMN", "mLMPsetscancfg", [this](FieldWriter& w) {
-        w.unsignedValue(c_.frequencyUnits());
-        w.unsignedValue(1, 16);
-        w.unsignedValue(c_.resolutionUnits());
-        w.signedValue(c_.startUnits());
-        w.signedValue(c_.stopUnits());
-      });
+      auto r = request(setScanConfigRequest(c_.protocol, c_.frequencyUnits(), area()));
       const auto result = r->unsignedValue("result", 8);
       if (result != 0) {
         static const char* WHY[] = {"", "frequency not supported", "resolution not supported",
@@ -223,23 +210,18 @@ class Lms111Driver::Session {
     }
   }
 
-  void waitUntilReady() {
-    const double deadline = steadySeconds() + c_.ready_timeout_s;
-    int state = -1;
-    while (steadySeconds() < deadline && !d_.stopping_) {
-      auto r = request("sRN", "STlms");
-      state = static_cast<int>(r->unsignedValue("state", 16));
-      if (state == STATE_READY_FOR_MEASUREMENT)
-        return;
-      d_.sleepFor(STATE_POLL_S);
+  // The device's state, for a message: best effort, as the device may be what failed.
+  std::string stateForMessage() {
+    try {
+      auto r = request(plainRequest(c_.protocol, "sRN", "STlms"), STOP_REPLY_TIMEOUT_S);
+      return deviceStateName(static_cast<int>(r->unsignedValue("state", 16)));
+    } catch (const Error&) {
+      return "unknown";
     }
-    throw Error(ErrorCode::IO_FAILURE, "the device did not become ready for measurement within " +
-                                           std::to_string(c_.ready_timeout_s) +
-                                           " s (state: " + deviceStateName(state) + ")");
   }
 
   void verifyScanConfig() {
-    auto r = request("sRN", "LMPscancfg");
+    auto r = request(plainRequest(c_.protocol, "sRN", "LMPscancfg"));
     const auto frequency = r->unsignedValue("scan frequency");
     r->unsignedValue("sectors", 16);
     const auto resolution = r->unsignedValue("resolution");
@@ -263,7 +245,7 @@ class Lms111Driver::Session {
       m << "the device streams " << s.scanFrequencyHz() << " Hz / " << dist->stepDeg()
         << " deg, not the requested " << c_.scan_frequency_hz << " Hz / "
         << c_.angular_resolution_deg << " deg";
-    } else if (dist->start_angle != c_.startUnits() ||
+    } else if (std::abs(dist->start_angle - c_.startUnits()) > ANGLE_TOLERANCE_UNITS ||
                static_cast<int>(dist->values.size()) != c_.beamCount()) {
       m << "the device streams " << dist->values.size() << " beams from " << dist->startAngleDeg()
         << " deg, not the requested " << c_.beamCount() << " from " << c_.start_angle_deg << " deg";
@@ -275,26 +257,36 @@ class Lms111Driver::Session {
     throw Error(ErrorCode::INVALID_ARGUMENT, m.str());
   }
 
+  // Scans until stopped. The first scan may take the motor's spin-up (ready_timeout_s): a
+  // device sends scans only once it is ready for measurement, which is the readiness test that
+  // does not depend on how a firmware lays out `STlms`.
   void stream() {
     const double period = 1.0 / c_.scan_frequency_hz;
     const double timeout = std::max(MIN_SCAN_TIMEOUT_S, c_.scan_timeout_periods * period);
     bool verified = false;
     std::optional<std::uint16_t> last_counter;
     while (!d_.stopping_) {
-      const auto payload = nextPayload(timeout);
+      const auto payload = nextPayload(verified ? timeout : c_.ready_timeout_s);
       if (d_.stopping_)
         return;
+      if (!payload && !verified) {
+        throw Error(ErrorCode::IO_FAILURE,
+                    "no scan within " + std::to_string(c_.ready_timeout_s) +
+                        " s of switching the stream on (device state: " + stateForMessage() + ")");
+      }
       if (!payload) {
         throw Error(ErrorCode::IO_FAILURE, "no scan within " + std::to_string(timeout) +
                                                " s (device silent or connection half-open)");
       }
       const double received = d_.clock_();
+      if (!isScanTelegram(*payload)) {
+        noteOtherTelegram(*payload);
+        continue;
+      }
       ScanTelegram scan;
       try {
         scan = parseScanTelegram(*payload, c_.protocol);
       } catch (const Error& e) {
-        if (payload->compare(0, 3, "sSN") != 0 && payload->compare(0, 3, "sRA") != 0)
-          continue;  // a late reply, not a scan
         std::lock_guard<std::mutex> lock(d_.mutex_);
         ++d_.stats_.parse_errors;
         d_.stats_.last_error = std::string("parse error: ") + e.what();
@@ -335,25 +327,29 @@ class Lms111Driver::Session {
     if (!connection_.isOpen())
       return;
     try {
-      request(
-          "sEN", "LMDscandata", [](FieldWriter& w) { w.unsignedValue(0, 8); },
-          STOP_REPLY_TIMEOUT_S);
+      request(streamRequest(c_.protocol, false), STOP_REPLY_TIMEOUT_S);
     } catch (const Error&) {
     }
     connection_.close();
   }
 
  private:
-  static std::string replyType(const std::string& type) {
-    if (type == "sRN")
-      return "sRA";
-    if (type == "sWN")
-      return "sWA";
-    if (type == "sMN")
-      return "sAN";
-    if (type == "sEN")
-      return "sEA";
-    return type;
+  // A scan, as opposed to the events and late replies a device interleaves with them.
+  bool isScanTelegram(const std::string& payload) const {
+    return payload.compare(0, 16, "sSN LMDscandata ") == 0 ||
+           payload.compare(0, 16, "sRA LMDscandata ") == 0;
+  }
+
+  // Events (sSN LIDoutputstate, LIDinputstate, LFErec, ...) are counted; an sFA while
+  // streaming is logged.
+  void noteOtherTelegram(const std::string& payload) {
+    if (payload.compare(0, 3, "sSN") == 0) {
+      std::lock_guard<std::mutex> lock(d_.mutex_);
+      ++d_.stats_.events;
+      return;
+    }
+    if (payload.compare(0, 3, "sFA") == 0)
+      d_.log(1, "the device sent '" + printableBytes(payload) + "' while streaming");
   }
 
   Lms111Driver& d_;

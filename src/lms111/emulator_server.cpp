@@ -218,6 +218,15 @@ struct EmulatorServer::Impl {
       s->send(bytes);
       ++sent;
     }
+    // A recording's events (LIDoutputstate, LFErec, ...) come between the scans, as a real
+    // device's do once a client subscribed them.
+    if (auto event = device->nextEvent(Protocol::COLA_B)) {
+      const std::string framed_event = frame(Protocol::COLA_B, *event);
+      for (auto& s : all) {
+        if (s->state.streaming && s->state.protocol == Protocol::COLA_B)
+          s->send(framed_event);
+      }
+    }
     if (faults.drop_after > 0 && scans_sent == faults.drop_after) {
       for (auto& s : all)
         s->close();

@@ -5,6 +5,7 @@
 #include <iterator>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/capture.h"
 #include "dormant_tree_modeling/lms111/cola.h"
 
 namespace dormant_tree_modeling {
@@ -26,18 +27,22 @@ std::string telegramText(const std::string& data) {
 }
 
 std::string readTelegramFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot open telegram file " + path);
-  const std::string data((std::istreambuf_iterator<char>(in)), {});
-  return telegramText(data);
+  return telegramText(readRecording(path, "telegram file"));
 }
 
-RecordedScanSource::RecordedScanSource(ScanTelegram telegram) : telegram_(std::move(telegram)) {
-  const ScanChannel* dist = telegram_.channel("DIST1");
-  if (!dist || dist->values.empty() || dist->angular_step == 0) {
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "a recorded scan needs a DIST1 channel with values and a non-zero step");
+RecordedScanSource::RecordedScanSource(ScanTelegram telegram)
+    : RecordedScanSource(std::vector<ScanTelegram>{std::move(telegram)}) {}
+
+RecordedScanSource::RecordedScanSource(std::vector<ScanTelegram> telegrams)
+    : telegrams_(std::move(telegrams)) {
+  if (telegrams_.empty())
+    throw Error(ErrorCode::INVALID_ARGUMENT, "a recorded scan source needs at least one scan");
+  for (const auto& t : telegrams_) {
+    const ScanChannel* dist = t.channel("DIST1");
+    if (!dist || dist->values.empty() || dist->angular_step == 0) {
+      throw Error(ErrorCode::INVALID_ARGUMENT,
+                  "a recorded scan needs a DIST1 channel with values and a non-zero step");
+    }
   }
 }
 
@@ -45,9 +50,10 @@ RecordedScanSource RecordedScanSource::fromFile(const std::string& path) {
   return RecordedScanSource(parseScanTelegram(readTelegramFile(path)));
 }
 
-ScanContent RecordedScanSource::scan(const ScanGeometry& geometry, double, std::uint64_t) {
-  const ScanChannel& dist = *telegram_.channel("DIST1");
-  const ScanChannel* rssi = telegram_.channel("RSSI1");
+ScanContent RecordedScanSource::scan(const ScanGeometry& geometry, double, std::uint64_t index) {
+  const ScanTelegram& telegram = telegrams_[index % telegrams_.size()];
+  const ScanChannel& dist = *telegram.channel("DIST1");
+  const ScanChannel* rssi = telegram.channel("RSSI1");
   ScanContent out;
   out.distances_mm.assign(geometry.count, 0);
   out.rssi.assign(geometry.count, 0);

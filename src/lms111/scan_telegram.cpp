@@ -70,9 +70,11 @@ std::string hex(std::uint64_t v) {
 }  // namespace
 
 const ScanChannel* ScanTelegram::channel(const std::string& name) const {
-  for (const auto& c : channels16) {
-    if (c.name == name)
-      return &c;
+  for (const auto* list : {&channels16, &channels8}) {
+    for (const auto& c : *list) {
+      if (c.name == name)
+        return &c;
+    }
   }
   return nullptr;
 }

@@ -1,11 +1,13 @@
 // lms111_emulator: a SICK LMS111 on 127.0.0.1 (CoLa-A and CoLa-B), scanning a synthetic
-// orchard or replaying a recorded telegram, with fault injection for tests.
+// orchard, replaying a recorded telegram or a whole recorded session, with fault injection.
 #include <boost/program_options.hpp>
 #include <iostream>
+#include <typeinfo>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/emulator_server.h"
+#include "dormant_tree_modeling/lms111/session_replay.h"
 #include "dormant_tree_modeling/lms111/simulated_scan_source.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "serve_loop.h"
@@ -17,15 +19,16 @@ int main(int argc, char** argv) {
   lms111::EmulatorServerOptions server;
   lms111::EmulatorConfig device;
   lms111::EmulatorFaults faults;
-  std::string telegram, scene_path, preset = "young_tall_spindle";
+  std::string telegram, session, scene_path, preset = "young_tall_spindle";
   std::uint64_t seed = 1;
   double distance = 1.5, height = 1.5, noise_mm = 12.0, frequency = 25.0, duration = 0.0;
   std::vector<std::string> sfa;
   po::options_description desc(
       "Usage: lms111_emulator [options]\n"
       "Serves an emulated SICK LMS111 until SIGINT/SIGTERM (or --duration). Scans come from a "
-      "synthetic orchard seen from a fixed pose in front of its target tree, or from a recorded "
-      "telegram (--telegram).");
+      "synthetic orchard seen from a fixed pose in front of its target tree, from a recorded "
+      "telegram (--telegram), or from a recorded CoLa-B session (--session: recorded replies to "
+      "the requests the recorded host sent, the recorded events and scans).");
   desc.add_options()("help,h", "this help")(
       "address", po::value(&server.address)->default_value(server.address), "listen address")(
       "cola-a-port", po::value(&server.cola_a_port)->default_value(server.cola_a_port),
@@ -33,6 +36,11 @@ int main(int argc, char** argv) {
       "cola-b-port", po::value(&server.cola_b_port)->default_value(server.cola_b_port),
       "CoLa-B port (0: any free one, -1: off)")(
       "telegram", po::value(&telegram), "replay this recorded LMDscandata telegram (text file)")(
+      "session", po::value(&session),
+      "replay this recorded CoLa-B session ('<seconds> <hex>' lines)")(
+      "angle-error-units",
+      po::value(&device.reported_angle_error)->default_value(device.reported_angle_error),
+      "report LMPoutputRange this many 1/10000 deg inside the nominal range, as real units do")(
       "scene", po::value(&scene_path), "scan this scene (scene.json of synth_tree)")(
       "preset", po::value(&preset)->default_value(preset), "synthetic orchard preset")(
       "seed", po::value(&seed)->default_value(seed), "synthetic orchard seed")(
@@ -69,8 +77,18 @@ int main(int argc, char** argv) {
       throw Error(ErrorCode::INVALID_ARGUMENT, "--frequency must be 25 or 50");
     device.scan.frequency = frequency == 25.0 ? 2500 : 5000;
     device.scan.resolution = device.scan.frequency;
+    if (!telegram.empty() && !session.empty())
+      throw Error(ErrorCode::INVALID_ARGUMENT, "--telegram and --session exclude each other");
+    for (const int port : {server.cola_a_port, server.cola_b_port}) {
+      if (port < -1 || port > 65535)
+        throw Error(ErrorCode::INVALID_ARGUMENT,
+                    "ports must be in 0..65535 (or -1: off), not " + std::to_string(port));
+    }
+    std::shared_ptr<lms111::EmulatedLms111> emulated;
     std::shared_ptr<lms111::ScanSource> source;
-    if (!telegram.empty()) {
+    if (!session.empty()) {
+      emulated = lms111::makeSessionReplay(lms111::readSessionFile(session), device, faults);
+    } else if (!telegram.empty()) {
       source = std::make_shared<lms111::RecordedScanSource>(
           lms111::RecordedScanSource::fromFile(telegram));
     } else {
@@ -82,7 +100,8 @@ int main(int argc, char** argv) {
       source = std::make_shared<lms111::SimulatedScanSource>(
           scene, [pose](double) { return pose; }, sensor, seed);
     }
-    auto emulated = std::make_shared<lms111::EmulatedLms111>(device, source, faults);
+    if (!emulated)
+      emulated = std::make_shared<lms111::EmulatedLms111>(device, source, faults);
     lms111::EmulatorServer running(emulated, server);
     std::cout << "lms111_emulator: listening on " << server.address << ", CoLa-A port "
               << running.colaAPort() << ", CoLa-B port " << running.colaBPort() << std::endl;
@@ -97,5 +116,8 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "lms111_emulator: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "lms111_emulator: unexpected " << typeid(e).name() << ": " << e.what() << "\n";
+    return 1;
   }
 }

@@ -72,13 +72,14 @@ TEST_F(DeviceFixture, UnknownCommandsMissingArgumentsAndWrongStateAnswerSfa) {
 
 TEST_F(DeviceFixture, ScansFollowTheConfigurationAndCountersAdvance) {
   ask("sMN SetAccessMode 3 F4724744");
-  ask("sWN LMDscandatacfg 1 1 0 0 0 0 1 0 1 1");
+  EXPECT_EQ(ask("sWN LMDscandatacfg 01 00 1 0 0 00 00 0 1 0 1 +1"), "sWA LMDscandatacfg");
   ask("sMN Run");
   const auto a = device_.nextScan(12.0), b = device_.nextScan(12.04);
   ASSERT_TRUE(a && b);
   EXPECT_EQ(static_cast<std::uint16_t>(b->scan_counter - a->scan_counter), 1);
   EXPECT_EQ(b->time_since_startup_us - a->time_since_startup_us, 40000u);
-  ASSERT_EQ(a->channels16.size(), 2u);  // DIST1 and RSSI1
+  ASSERT_EQ(a->channels16.size(), 1u);  // DIST1
+  ASSERT_EQ(a->channels8.size(), 1u);   // RSSI1 as the 8-bit values that were asked for
   EXPECT_EQ(a->channels16[0].values.size(), 1081u);
   EXPECT_EQ(a->channels16[0].angular_step, 2500);
   EXPECT_EQ(a->measurement_frequency, 360u);  // 36 kHz rays over the full turn

@@ -100,8 +100,46 @@ class ColaBFramer : public Framer {
 /// @returns nothing when the token is not a number of either form
 std::optional<std::int64_t> parseColaNumber(const std::string& token);
 
-/// @brief Readable text of an `sFA` error code (docs/hardware.md).
+/// @brief `sFA` error codes (docs/protocols.md; numbering as in SICK's SOPAS error table, which
+/// the public sick_scan_xd driver lists in full).
+enum SfaCode : int {
+  SFA_ACCESS_DENIED = 1,
+  SFA_UNKNOWN_METHOD = 2,
+  SFA_UNKNOWN_VARIABLE = 3,
+  SFA_LOCAL_CONDITION = 4,
+  SFA_INVALID_DATA = 5,
+  SFA_UNKNOWN_ERROR = 6,
+  SFA_BUFFER_OVERFLOW = 7,
+  SFA_BUFFER_UNDERFLOW = 8,
+  SFA_UNKNOWN_TYPE = 9,
+  SFA_WRITE_ACCESS_DENIED = 10,
+  SFA_UNKNOWN_NAMESERVER_COMMAND = 11,
+  SFA_UNKNOWN_COLA_COMMAND = 12,
+  SFA_SERVER_BUSY = 13,
+  SFA_FLEX_OUT_OF_BOUNDS = 14,
+  SFA_UNKNOWN_EVENT = 15,
+  SFA_COLA_A_VALUE_OVERFLOW = 16,
+  SFA_COLA_A_INVALID_CHARACTER = 17,
+};
+
+/// @brief Readable text of an `sFA` error code.
 std::string describeSfaError(int code);
+
+/// @brief The "authorised client" login of `sMN SetAccessMode` (level 3 and the password hash
+/// every public LMS1xx driver sends).
+constexpr int AUTHORISED_CLIENT_LEVEL = 3;
+constexpr std::uint32_t AUTHORISED_CLIENT_PASSWORD = 0xF4724744;
+
+/// @brief `STlms` state "ready for measurement".
+constexpr int STATE_READY_FOR_MEASUREMENT = 7;
+
+/// @brief The reply type of a request type: sRN -> sRA, sWN -> sWA, sMN -> sAN, sEN -> sEA;
+/// anything else maps to itself.
+std::string replyTypeOf(const std::string& request_type);
+
+/// @brief Device bytes fit for a log line: printable ASCII as it is, every other byte as
+/// `\xNN`, cut after `max_bytes` with "...".
+std::string printableBytes(const std::string& bytes, std::size_t max_bytes = 120);
 
 /// @brief Name of a device state as `STlms` reports it (0 undefined ... 7 ready).
 std::string deviceStateName(int state);

@@ -16,12 +16,6 @@
 namespace dormant_tree_modeling {
 namespace lms111 {
 
-/// @brief The password hash of the "authorised client" access level 3 (docs/hardware.md).
-constexpr std::uint32_t AUTHORISED_CLIENT_PASSWORD = 0xF4724744;
-constexpr int AUTHORISED_CLIENT_LEVEL = 3;
-/// @brief `STlms` state "ready for measurement".
-constexpr int STATE_READY_FOR_MEASUREMENT = 7;
-
 /// @brief Scan configuration as the device holds it, in the device's units.
 struct DeviceScanConfig {
   std::uint32_t frequency = 2500;      ///< 1/100 Hz
@@ -36,6 +30,7 @@ struct DeviceScanConfig {
 /// @brief What `LMDscandatacfg` selects for the scan telegrams.
 struct DataOutputConfig {
   bool rssi = false;
+  bool rssi_16bit = false;  ///< RSSI1 among the 16-bit channels; else among the 8-bit ones
   bool device_name = false;
   bool comment = false;
   bool time_stamp = false;
@@ -73,6 +68,17 @@ struct EmulatorConfig {
   double clock_drift_ppm = 0.0;      ///< device oscillator error against the host clock
   std::uint32_t clock_start_us = 0;  ///< device clock at power-up (set near 2^32 to test wrap)
   DeviceScanConfig scan;             ///< the configuration it powers up with
+  /// Real units answer `LMPoutputRange` a few 1/10000 deg inside the nominal range (-449997 ...
+  /// 2249997 on a real LMS111); 0 reports the nominal one.
+  std::int32_t reported_angle_error = 0;
+};
+
+/// @brief What a recorded CoLa-B session tells an emulated device (SessionReplay builds it):
+/// the replies the real device gave, the size of each request it took, and the events it sent.
+struct RecordedReplies {
+  std::map<std::string, std::string> reply_to;       ///< request payload -> recorded reply
+  std::map<std::string, std::size_t> request_bytes;  ///< "sWN LMDscandatacfg" -> payload size
+  std::vector<std::string> events;  ///< `sSN` payloads other than scans, in recorded order
 };
 
 /// @brief One client connection's view of the device.
@@ -94,7 +100,8 @@ class EmulatedLms111 {
   EmulatedLms111(EmulatorConfig config, std::shared_ptr<ScanSource> source,
                  EmulatorFaults faults = {});
 
-  /// @brief Replies to one request payload (usually one; none for an unanswered stall).
+  /// @brief Replies to one request payload: the reply, preceded by a recorded event when a
+  /// recording with events is set.
   /// @param now_s seconds since the emulator started (steady clock)
   std::vector<std::string> handle(const std::string& payload, EmulatorSession& session,
                                   double now_s);
@@ -111,6 +118,14 @@ class EmulatedLms111 {
   /// @brief Reboot: configuration back to the power-up values, counters and clock restart.
   void powerUp(double now_s);
 
+  /// @brief Answer CoLa-B requests from a recording: a request of a recorded command must have
+  /// the recorded size (else `sFA` 7 or 8, before any other check), and one identical to a
+  /// recorded request gets the recorded reply once the emulator accepted it. Every reply is
+  /// preceded by the next recorded event, as a device does whose events a client subscribed.
+  void setRecording(RecordedReplies recording) { recording_ = std::move(recording); }
+  /// @brief The next recorded event for a connection of that protocol (CoLa-B only), cycling.
+  std::optional<std::string> nextEvent(Protocol protocol);
+
   const EmulatorFaults& faults() const { return faults_; }
   const DeviceScanConfig& scanConfig() const { return active_; }
   const DataOutputConfig& outputConfig() const { return output_; }
@@ -120,8 +135,10 @@ class EmulatedLms111 {
                     const std::string& name,
                     const std::function<void(FieldWriter&)>& fields = {}) const;
   std::string sfa(const EmulatorSession& session, int code) const;
-  std::optional<std::string> dispatch(const std::string& type, const std::string& name,
-                                      FieldReader& args, EmulatorSession& session, double now_s);
+  std::string answer(const std::string& payload, const std::string& type, const std::string& name,
+                     FieldReader& args, EmulatorSession& session, double now_s);
+  std::string dispatch(const std::string& type, const std::string& name, FieldReader& args,
+                       EmulatorSession& session, double now_s);
 
   EmulatorConfig config_;
   std::shared_ptr<ScanSource> source_;
@@ -133,6 +150,8 @@ class EmulatedLms111 {
   double ready_at_s_ = 0.0;
   std::uint16_t telegram_counter_ = 0, scan_counter_ = 0;
   std::uint64_t scans_ = 0;
+  std::optional<RecordedReplies> recording_;
+  std::size_t next_event_ = 0;
 };
 
 }  // namespace lms111

@@ -29,7 +29,7 @@ struct DriverConfig {
   double connect_timeout_s = 3.0;
   double reply_timeout_s = 2.0;       ///< per request
   double scan_timeout_periods = 5.0;  ///< no scan within this many periods: reconnect
-  double ready_timeout_s = 30.0;      ///< STlms must reach 7 within this (motor spin-up)
+  double ready_timeout_s = 30.0;      ///< the first scan must come within this (motor spin-up)
   double reconnect_min_s = 0.2;       ///< first back-off; doubles per failure
   double reconnect_max_s = 5.0;
 
@@ -57,11 +57,12 @@ struct DriverStatistics {
   std::uint64_t parse_errors = 0;     ///< telegrams that did not parse
   std::uint64_t discarded_bytes = 0;  ///< framing resynchronisations (bytes or frames)
   std::uint64_t scan_gaps = 0;        ///< scans missing by the device's scan counter
-  std::uint64_t connects = 0;         ///< successful start-ups
-  std::uint64_t failures = 0;         ///< start-ups or streams that ended in an error
-  std::uint8_t device_status = 0;     ///< last telegram's: 0 ok, 1 error, 2/5 pollution
-  std::string device_ident;           ///< DeviceIdent of the connected device
-  std::string last_error;             ///< most recent failure, readable
+  std::uint64_t events = 0;    ///< other `sSN` events (LIDoutputstate, LFErec, ...), passed over
+  std::uint64_t connects = 0;  ///< successful start-ups
+  std::uint64_t failures = 0;  ///< start-ups or streams that ended in an error
+  std::uint8_t device_status = 0;  ///< last telegram's: 0 ok, 1 error, 2/5 pollution
+  std::string device_ident;        ///< DeviceIdent of the connected device
+  std::string last_error;          ///< most recent failure, readable
 };
 
 /// @brief One scan as delivered: the telegram and its stamp.

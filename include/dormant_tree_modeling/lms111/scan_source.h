@@ -36,14 +36,18 @@ class ScanSource {
   virtual ScanContent scan(const ScanGeometry& geometry, double time_s, std::uint64_t index) = 0;
 };
 
-/// @brief Replays the DIST1 (and RSSI1, if present) channel of one recorded telegram. When the
-/// device is configured for other angles than the recording, each beam takes the recorded beam
-/// nearest in angle, and beams outside the recorded range report no echo.
+/// @brief Replays the DIST1 (and RSSI1, if present) channel of recorded telegrams, one after
+/// the other and over again. When the device is configured for other angles than the
+/// recording, each beam takes the recorded beam nearest in angle, and beams outside the
+/// recorded range report no echo.
 class RecordedScanSource : public ScanSource {
  public:
   /// @param telegram a decoded telegram with a DIST1 channel
   /// @throws Error INVALID_ARGUMENT without a DIST1 channel or with an empty one
   explicit RecordedScanSource(ScanTelegram telegram);
+  /// @param telegrams decoded telegrams, each with a DIST1 channel
+  /// @throws Error INVALID_ARGUMENT for none, or one without a usable DIST1 channel
+  explicit RecordedScanSource(std::vector<ScanTelegram> telegrams);
 
   /// @brief Read a CoLa-A telegram from a text file (STX/ETX optional).
   /// @throws Error FILE_NOT_FOUND, PARSE_ERROR
@@ -52,7 +56,7 @@ class RecordedScanSource : public ScanSource {
   ScanContent scan(const ScanGeometry& geometry, double time_s, std::uint64_t index) override;
 
  private:
-  ScanTelegram telegram_;
+  std::vector<ScanTelegram> telegrams_;
 };
 
 /// @brief The telegram text in saved data: with framing the first complete telegram, without

@@ -76,7 +76,8 @@ struct ScanTelegram {
   std::optional<ScanTimestamp> timestamp;
   std::optional<ScanEvent> event;
 
-  /// @brief The 16-bit channel of that name, if present.
+  /// @brief The channel of that name, 16-bit or 8-bit (RSSI1 comes as 8-bit values when
+  /// `LMDscandatacfg` asked for 8-bit remission), if present.
   const ScanChannel* channel(const std::string& name) const;
   double scanFrequencyHz() const { return scan_frequency / 100.0; }
   /// @brief Time between two rays, s (1 / (measurement frequency x 100 Hz)).

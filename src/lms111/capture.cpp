@@ -1,0 +1,197 @@
+#include "dormant_tree_modeling/lms111/capture.h"
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace lms111 {
+
+namespace {
+
+const std::string COLA_B_MAGIC(4, '\x02');
+constexpr std::size_t COLA_B_HEADER = 8;  // magic + 32-bit length
+
+int hexValue(char c) {
+  if (c >= '0' && c <= '9')
+    return c - '0';
+  if (c >= 'a' && c <= 'f')
+    return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F')
+    return c - 'A' + 10;
+  return -1;
+}
+
+bool parseHex(const std::string& hex, std::string& out) {
+  if (hex.size() % 2 != 0)
+    return false;
+  out.reserve(out.size() + hex.size() / 2);
+  for (std::size_t i = 0; i < hex.size(); i += 2) {
+    const int hi = hexValue(hex[i]), lo = hexValue(hex[i + 1]);
+    if (hi < 0 || lo < 0)
+      return false;
+    out.push_back(static_cast<char>(hi * 16 + lo));
+  }
+  return true;
+}
+
+bool splitSessionLine(const std::string& line, double& seconds, std::string& hex) {
+  std::istringstream in(line);
+  std::string time_text, extra;
+  if (!(in >> time_text >> hex) || (in >> extra))
+    return false;
+  try {
+    std::size_t used = 0;
+    seconds = std::stod(time_text, &used);
+    return used == time_text.size();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool isDataLine(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  return first != std::string::npos && line[first] != '#';
+}
+
+}  // namespace
+
+std::string readRecording(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw Error(ErrorCode::FILE_NOT_FOUND, what + " " + path + " is a directory, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot open " + what + " " + path);
+  try {
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  } catch (const std::exception& e) {
+    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot read " + what + " " + path + ": " + e.what());
+  }
+}
+
+std::vector<CapturedTelegram> cutColaBStream(const std::string& bytes) {
+  std::vector<CapturedTelegram> out;
+  std::size_t pos = bytes.find(COLA_B_MAGIC);
+  while (pos != std::string::npos) {
+    CapturedTelegram t;
+    t.offset = pos;
+    if (bytes.size() - pos < COLA_B_HEADER) {
+      t.error = "cut-off frame (no length field)";
+      out.push_back(t);
+      break;
+    }
+    std::uint64_t length = 0;
+    for (std::size_t i = 4; i < COLA_B_HEADER; ++i)
+      length = (length << 8) | static_cast<unsigned char>(bytes[pos + i]);
+    if (length + 1 > bytes.size() - pos - COLA_B_HEADER) {
+      t.error = "cut-off frame (" + std::to_string(length) + " payload bytes declared, " +
+                std::to_string(bytes.size() - pos - COLA_B_HEADER) + " left)";
+      out.push_back(t);
+      // A corrupt length can swallow good frames: resynchronise just past this magic.
+      pos = bytes.find(COLA_B_MAGIC, pos + 1);
+      continue;
+    }
+    const std::string payload = bytes.substr(pos + COLA_B_HEADER, length);
+    char sum = 0;
+    for (const char c : payload)
+      sum = static_cast<char>(sum ^ c);
+    const std::size_t end = pos + COLA_B_HEADER + length + 1;
+    if (sum != bytes[end - 1]) {
+      t.error = "bad checksum";
+      out.push_back(t);
+      pos = bytes.find(COLA_B_MAGIC, pos + 1);
+      continue;
+    }
+    t.payload = payload;
+    out.push_back(std::move(t));
+    pos = bytes.find(COLA_B_MAGIC, end);
+  }
+  return out;
+}
+
+std::vector<CapturedTelegram> cutColaAStream(const std::string& bytes) {
+  std::vector<CapturedTelegram> out;
+  std::size_t pos = bytes.find(STX);
+  while (pos != std::string::npos) {
+    const std::size_t end = bytes.find_first_of(std::string{STX, ETX}, pos + 1);
+    CapturedTelegram t;
+    t.offset = pos;
+    if (end == std::string::npos || bytes[end] == STX) {
+      t.error = "cut-off telegram (no ETX before the " +
+                std::string(end == std::string::npos ? "end" : "next STX") + ")";
+      out.push_back(t);
+      pos = end;
+      continue;
+    }
+    t.payload = bytes.substr(pos + 1, end - pos - 1);
+    out.push_back(std::move(t));
+    pos = bytes.find(STX, end + 1);
+  }
+  return out;
+}
+
+bool isSessionText(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!isDataLine(line))
+      continue;
+    double seconds = 0;
+    std::string hex, bytes;
+    return splitSessionLine(line, seconds, hex) && parseHex(hex, bytes);
+  }
+  return false;
+}
+
+std::vector<CapturedTelegram> readSessionText(const std::string& text) {
+  // The stream is the lines' bytes in order; each frame takes the time of the line it starts on.
+  std::string stream;
+  std::vector<std::pair<std::size_t, double>> line_starts;
+  std::istringstream in(text);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (!isDataLine(line))
+      continue;
+    double seconds = 0;
+    std::string hex;
+    line_starts.emplace_back(stream.size(), 0.0);
+    if (!splitSessionLine(line, seconds, hex) || !parseHex(hex, stream)) {
+      throw Error(ErrorCode::PARSE_ERROR,
+                  "session line " + std::to_string(number) + " is not '<seconds> <hex bytes>'");
+    }
+    line_starts.back().second = seconds;
+  }
+  auto telegrams = cutColaBStream(stream);
+  std::size_t current = 0;
+  for (auto& t : telegrams) {
+    while (current + 1 < line_starts.size() && line_starts[current + 1].first <= t.offset)
+      ++current;
+    if (!line_starts.empty())
+      t.time_s = line_starts[current].second;
+  }
+  return telegrams;
+}
+
+bool isRequestType(const std::string& type) {
+  return type == "sRN" || type == "sWN" || type == "sMN" || type == "sEN";
+}
+
+std::pair<std::string, std::string> commandWords(const std::string& payload) {
+  const std::size_t a = payload.find(' ');
+  if (a == std::string::npos || a == 0)
+    return {};
+  std::size_t b = payload.find(' ', a + 1);
+  if (b == std::string::npos)
+    b = payload.size();
+  if (b == a + 1)
+    return {};
+  return {payload.substr(0, a), payload.substr(a + 1, b - a - 1)};
+}
+
+}  // namespace lms111
+}  // namespace dormant_tree_modeling
