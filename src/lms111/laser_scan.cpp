@@ -34,9 +34,12 @@ LaserScanData toLaserScan(const ScanTelegram& scan, double range_min, double ran
   const float inf = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     // 0 is the device's "no echo"; REP 117 reports that, and anything beyond the range, as
-    // +Inf and a return too close to measure as -Inf.
+    // +Inf and a return too close to measure as -Inf. Raw values 1 ... 15 are the device's
+    // codes for an invalid measurement (dazzled, reserved), not distances: NaN.
     const double m = (dist->values[i] * static_cast<double>(dist->scale) + dist->offset) * 1e-3;
-    if (dist->values[i] == 0 || m > range_max)
+    if (dist->values[i] > 0 && dist->values[i] < FIRST_VALID_DISTANCE)
+      out.ranges[i] = std::numeric_limits<float>::quiet_NaN();
+    else if (dist->values[i] == 0 || m > range_max)
       out.ranges[i] = inf;
     else if (m < range_min)
       out.ranges[i] = -inf;

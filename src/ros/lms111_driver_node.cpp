@@ -125,6 +125,7 @@ void Lms111DriverNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("scans", s.scans);
   status.add("scan counter gaps", s.scan_gaps);
   status.add("parse errors", s.parse_errors);
+  status.add("other events", s.events);
   status.add("discarded bytes", s.discarded_bytes);
   status.add("successful start-ups", s.connects);
   status.add("failures", s.failures);

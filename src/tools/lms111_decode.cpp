@@ -75,8 +75,8 @@ std::string summaryOf(const lms111::ScanTelegram& s) {
   double lo = -1, hi = -1;
   for (const auto v : dist->values) {
     const double mm = v * dist->scale + dist->offset;
-    if (v == 0)
-      continue;  // no echo
+    if (v < lms111::FIRST_VALID_DISTANCE)
+      continue;  // no echo, or a code for an invalid measurement
     lo = lo < 0 ? mm : std::min(lo, mm);
     hi = std::max(hi, mm);
   }

@@ -1,5 +1,7 @@
 // The lms111_driver node against the emulator process: rate, angles, counts, an sFA on a
-// configuration command, and a killed and restarted device.
+// configuration command, and a killed and restarted device (lms111_driver.test); and against a
+// device replaying a real session in CoLa-B and a real telegram in CoLa-A
+// (lms111_driver_real_session.test).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -23,12 +25,13 @@ int g_port = 22111;
 // Runs the emulator binary as a child process.
 class Emulator {
  public:
-  explicit Emulator(std::vector<std::string> extra) {
+  explicit Emulator(std::vector<std::string> extra, int cola_a_port = g_port,
+                    int cola_b_port = -1) {
     std::vector<std::string> args = {std::string(DTM_BIN_DIR) + "/lms111_emulator",
                                      "--cola-a-port",
-                                     std::to_string(g_port),
+                                     std::to_string(cola_a_port),
                                      "--cola-b-port",
-                                     "-1",
+                                     std::to_string(cola_b_port),
                                      "--spin-up",
                                      "0.1"};
     args.insert(args.end(), extra.begin(), extra.end());
@@ -172,6 +175,48 @@ TEST(Lms111DriverNode, StreamsRecoversFromSfaAndFromAKilledDevice) {
   EXPECT_LT(recovery, 3.0);
   std::printf("[ INFO ] scans resumed %.2f s after the device restarted\n", recovery);
   EXPECT_TRUE(rec.logged("closed the connection") || rec.logged("no scan within"));
+}
+
+// 541 beams at 50 Hz from one driver node, counted over 2 s.
+void expectStreams541BeamsAt50Hz(Recorder& rec, const char* what) {
+  ASSERT_TRUE(waitUntil([&] { return rec.count() >= 5; }, 15.0)) << what << ": no scans";
+  const std::size_t first = rec.count();
+  ros::WallDuration(2.0).sleep();
+  std::lock_guard<std::mutex> lock(rec.mutex);
+  const std::size_t last = rec.scans.size() - 1;
+  const double rate =
+      static_cast<double>(last - first) / (rec.received[last] - rec.received[first]);
+  EXPECT_NEAR(rate, 50.0, 2.0) << what;
+  const auto& s = rec.scans.back();
+  EXPECT_EQ(s.ranges.size(), 541u) << what;
+  EXPECT_EQ(s.intensities.size(), 541u) << what;
+  EXPECT_NEAR(s.angle_increment, 0.5 * M_PI / 180.0, 1e-7) << what;
+  int finite = 0;
+  for (const float r : s.ranges)
+    finite += std::isfinite(r) ? 1 : 0;
+  EXPECT_GT(finite, 100) << what << ": the recorded ranges";
+}
+
+TEST(RealSession, TheNodeStreamsFromTheReplayedSessionInCoLaBAndTheTelegramInCoLaA) {
+  ros::NodeHandle nh;
+  Recorder rec_b, rec_a;
+  ros::Subscriber sub_b = nh.subscribe("/lms111_b/scan", 200, &Recorder::scan, &rec_b);
+  ros::Subscriber sub_a = nh.subscribe("/lms111_a/scan", 200, &Recorder::scan, &rec_a);
+  ros::Subscriber diag_sub = nh.subscribe("/diagnostics", 10, &Recorder::diagnostics, &rec_b);
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  ASSERT_TRUE(waitUntil([&] { return sub_b.getNumPublishers() > 0; }, 20.0));
+  const std::string data = DTM_SHARED_DATA_DIR;
+  // Real units report their range a few 1/10000 deg off the nominal.
+  Emulator session(
+      {"--session", data + "/lms1xx/lms511_session_colab.txt", "--angle-error-units", "3"}, -1,
+      g_port);
+  Emulator telegram(
+      {"--telegram", data + "/lms1xx/lms1xx_scan_541pts.txt", "--angle-error-units", "3"},
+      g_port + 1, -1);
+  ASSERT_TRUE(session.running() && telegram.running());
+  expectStreams541BeamsAt50Hz(rec_b, "CoLa-B, replayed session");
+  expectStreams541BeamsAt50Hz(rec_a, "CoLa-A, recorded telegram");
 }
 
 }  // namespace

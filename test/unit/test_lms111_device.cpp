@@ -136,23 +136,24 @@ TEST(LaserScan, RosAnglesRep117AndIntensities) {
   d.name = "DIST1";
   d.start_angle = -450000;
   d.angular_step = 2500;
-  d.values = {0, 300, 1500, 25000};
+  d.values = {0, 300, 1500, 25000, 3};
   s.channels16.push_back(d);
   ScanChannel r = d;
   r.name = "RSSI1";
-  r.values = {0, 10, 200, 5};
+  r.values = {0, 10, 200, 5, 0};
   s.channels16.push_back(r);
   const LaserScanData l = toLaserScan(s, 0.5, 20.0);
   EXPECT_NEAR(l.angle_min, -135.0 * M_PI / 180.0, 1e-12);
   EXPECT_NEAR(l.angle_increment, 0.25 * M_PI / 180.0, 1e-12);
-  EXPECT_NEAR(l.angle_max, l.angle_min + 3 * l.angle_increment, 1e-12);
+  EXPECT_NEAR(l.angle_max, l.angle_min + 4 * l.angle_increment, 1e-12);
   EXPECT_NEAR(l.time_increment, 1.0 / 36000.0, 1e-12);
   EXPECT_NEAR(l.scan_time, 0.04, 1e-12);
   EXPECT_TRUE(std::isinf(l.ranges[0]) && l.ranges[0] > 0);  // no echo
   EXPECT_TRUE(std::isinf(l.ranges[1]) && l.ranges[1] < 0);  // too close
   EXPECT_FLOAT_EQ(l.ranges[2], 1.5f);
   EXPECT_TRUE(std::isinf(l.ranges[3]) && l.ranges[3] > 0);  // beyond range_max
-  EXPECT_EQ(l.intensities, (std::vector<float>{0, 10, 200, 5}));
+  EXPECT_TRUE(std::isnan(l.ranges[4]));  // the device's code for an invalid measurement
+  EXPECT_EQ(l.intensities, (std::vector<float>{0, 10, 200, 5, 0}));
   s.channels16[1].values.pop_back();
   EXPECT_THROW(toLaserScan(s, 0.5, 20.0), Error);
   s.channels16.clear();

@@ -12,6 +12,8 @@
 #include "dormant_tree_modeling/evaluation/ground_truth.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
 #include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/lms111/capture.h"
+#include "dormant_tree_modeling/lms111/session_replay.h"
 #include "temp_dir.h"
 
 namespace dormant_tree_modeling {
@@ -154,6 +156,43 @@ TEST(Lms111DecodeTool, DecodesTheRealTelegramAndRejectsOthers) {
   std::ofstream(dir.file("other.txt")) << "sRA STlms 7";
   EXPECT_EQ(run("lms111_decode", dir.file("other.txt"), &out), 4);
   EXPECT_NE(out.find("not a scan telegram"), std::string::npos) << out;
+  EXPECT_EQ(run("lms111_decode", dir.file(""), &out), 3);  // a directory
+  EXPECT_NE(out.find("is a directory"), std::string::npos) << out;
+}
+
+// Counts the lines that contain `part`.
+std::size_t linesWith(const std::string& text, const std::string& part) {
+  std::istringstream in(text);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);)
+    n += line.find(part) != std::string::npos;
+  return n;
+}
+
+TEST(Lms111DecodeTool, SummarisesARealCoLaBSessionAndReportsBrokenFramesByOffset) {
+  test::TempDir dir;
+  std::string out;
+  const std::string session = std::string(DTM_SHARED_DATA_DIR) + "/lms1xx/lms511_session_colab.txt";
+  ASSERT_EQ(run("lms111_decode", "--summary " + session, &out), 0) << out;
+  EXPECT_EQ(linesWith(out, "sSN LMDscandata telegram"), 20u) << out;
+  EXPECT_EQ(linesWith(out, "25.00 Hz 1141 beams -5.0000..185.0380 deg"), 20u);
+  EXPECT_NE(out.find("@0 t=0.202789 sMN SetAccessMode"), std::string::npos) << out;
+  EXPECT_NE(out.find("session (CoLa-B): 123 telegrams decoded, 0 failed"), std::string::npos);
+  // The same bytes as a binary capture, with one checksum broken and the end cut off.
+  std::string bytes;
+  for (const auto& t : lms111::readSessionFile(session))
+    bytes += lms111::frameColaB(t.payload);
+  const std::size_t broken = bytes.find(lms111::frameColaB("sAN Run \x01"));
+  ASSERT_NE(broken, std::string::npos);
+  bytes[broken + 8 + 9] ^= 0x10;  // the payload's last byte: the checksum no longer matches
+  std::ofstream(dir.file("capture.bin"), std::ios::binary) << bytes.substr(0, bytes.size() - 100);
+  ASSERT_EQ(run("lms111_decode", "--summary " + dir.file("capture.bin"), &out), 4) << out;
+  EXPECT_NE(out.find("@" + std::to_string(broken) + ": bad checksum"), std::string::npos) << out;
+  EXPECT_NE(out.find("cut-off frame"), std::string::npos) << out;
+  EXPECT_EQ(linesWith(out, "sSN LMDscandata telegram"), 20u) << "decoding went on";
+  // Without --summary: each scan as JSON.
+  ASSERT_EQ(run("lms111_decode", session, &out), 0);
+  EXPECT_EQ(linesWith(out, "\"count\": 1141"), 40u);  // DIST1 and RSSI1 of 20 scans
 }
 
 }  // namespace

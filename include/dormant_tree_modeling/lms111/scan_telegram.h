@@ -10,6 +10,10 @@
 namespace dormant_tree_modeling {
 namespace lms111 {
 
+/// @brief The smallest raw DIST value that is a distance: 0 means no echo, 1 ... 15 are the
+/// device's codes for an invalid measurement (1: dazzled; the rest reserved).
+constexpr std::uint16_t FIRST_VALID_DISTANCE = 16;
+
 /// @brief One data channel of an `LMDscandata` telegram (DIST1, RSSI1, ...).
 struct ScanChannel {
   std::string name;
