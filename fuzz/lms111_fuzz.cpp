@@ -1,7 +1,9 @@
-// libFuzzer target for everything that reads bytes from the LMS111's socket: the CoLa-A and
-// CoLa-B framers, the scan telegram parser in both protocols (with an encode/parse round-trip
-// property on whatever parses), the LaserScan conversion and the emulated device's command
-// interpreter. Built with clang's -fsanitize=fuzzer,address,undefined by `make fuzz`.
+// libFuzzer target for everything that reads bytes from the LMS111's socket or from a
+// recording: the CoLa-A and CoLa-B framers, the capture cutters and the session reader of
+// lms111_decode, the scan telegram parser in both protocols (with an encode/parse round-trip
+// property on whatever parses), the LaserScan conversion, the emulated device's command
+// interpreter and the session replay device. Built with clang's
+// -fsanitize=fuzzer,address,undefined by `make fuzz`.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -11,10 +13,12 @@
 #include <string>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/lms111/capture.h"
 #include "dormant_tree_modeling/lms111/cola.h"
 #include "dormant_tree_modeling/lms111/device_emulator.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
+#include "dormant_tree_modeling/lms111/session_replay.h"
 
 using namespace dormant_tree_modeling;
 using namespace dormant_tree_modeling::lms111;
@@ -60,6 +64,31 @@ void parseChecked(const std::string& payload, Protocol protocol) {
   scanTelegramToJson(scan);
 }
 
+// The recording paths: cut as a CoLa-B and a CoLa-A capture and as a session text; every
+// telegram found is decoded, and a session that holds a scan is replayed to its own requests.
+void recordingChecked(const std::string& bytes) {
+  for (const auto& t : cutColaBStream(bytes))
+    parseChecked(t.payload, Protocol::COLA_B);
+  for (const auto& t : cutColaAStream(bytes))
+    parseChecked(t.payload, Protocol::COLA_A);
+  std::vector<CapturedTelegram> session;
+  try {
+    session = readSessionText(bytes);
+  } catch (const Error&) {
+    return;
+  }
+  std::shared_ptr<EmulatedLms111> device;
+  try {
+    device = makeSessionReplay(session);
+  } catch (const Error&) {
+    return;
+  }
+  EmulatorSession s;
+  s.protocol = Protocol::COLA_B;
+  for (const auto& t : session)
+    device->handle(t.payload, s, 1.0);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -75,6 +104,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     while (auto payload = framer->next())
       parseChecked(*payload, p);
   }
+  recordingChecked(bytes);
   static auto source = std::make_shared<PatternSource>();
   for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
     EmulatedLms111 device(EmulatorConfig{}, source);
