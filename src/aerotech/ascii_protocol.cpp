@@ -108,10 +108,10 @@ std::string waitModeNoWait() {
   return "WAIT MODE NOWAIT";
 }
 std::string moveAbsolute(const std::string& axis, double position, double velocity) {
-  return "MOVEABS " + axis + " " + number(position) + " " + axis + "F " + number(velocity);
+  return "MOVEABS " + axis + " " + number(position) + " " + axis + "F" + number(velocity);
 }
 std::string moveIncremental(const std::string& axis, double distance, double velocity) {
-  return "MOVEINC " + axis + " " + number(distance) + " " + axis + "F " + number(velocity);
+  return "MOVEINC " + axis + " " + number(distance) + " " + axis + "F" + number(velocity);
 }
 std::string freerun(const std::string& axis, double velocity) {
   return "FREERUN " + axis + " " + number(velocity);
@@ -126,7 +126,10 @@ std::string acknowledgeAll() {
   return "ACKNOWLEDGEALL";
 }
 std::string positionFeedback(const std::string& axis) {
-  return "PFBK(" + axis + ")";
+  return "PFBKPROG(" + axis + ")";
+}
+std::string planeStatus(int plane) {
+  return "PLANESTATUS(" + std::to_string(plane) + ")";
 }
 std::string velocityFeedback(const std::string& axis) {
   return "VFBK(" + axis + ")";

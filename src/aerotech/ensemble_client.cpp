@@ -10,6 +10,9 @@ namespace aerotech {
 
 namespace {
 
+// The plane the ASCII interface's motion commands run in.
+constexpr int MOTION_PLANE = 0;
+
 double steadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -158,6 +161,11 @@ std::uint32_t EnsembleClient::faults(const std::string& axis) {
       checked(command::axisFault(axis), axis, config_.reply_timeout_s, true).number());
 }
 
+bool EnsembleClient::planeMoving() {
+  const Reply r = checked(command::planeStatus(MOTION_PLANE), "", config_.reply_timeout_s, true);
+  return (static_cast<std::uint32_t>(r.number()) & PLANE_MOTION_ACTIVE) != 0;
+}
+
 void EnsembleClient::waitForMove(const std::string& axis, double timeout_s, double poll_s) {
   const double deadline = steadySeconds() + timeout_s;
   for (;;) {
@@ -167,7 +175,9 @@ void EnsembleClient::waitForMove(const std::string& axis, double timeout_s, doub
       throw Error(ErrorCode::IO_FAILURE,
                   "axis " + axis + " faulted during the move: " + describeFaults(f));
     }
-    if (s.inPosition() && !s.moveActive())
+    // The plane's motion flag as well: AXISSTATUS alone can report "in position, no move"
+    // before a just-issued move starts, or through a jog's end (motorAerotech's fix .13).
+    if (s.inPosition() && !s.moveActive() && !planeMoving())
       return;
     if (!s.enabled())
       throw Error(ErrorCode::IO_FAILURE, "axis " + axis + " was disabled during the move");

@@ -202,16 +202,20 @@ EnsembleResponse EmulatedEnsemble::handle(const std::string& line, double now_s)
   const EnsembleResponse fault{"#", now_s};
   const EnsembleResponse ok{"%", now_s};
   std::string text = line;
-  // Queries: NAME(axis)
+  // Queries: NAME(axis), PLANESTATUS(plane)
   const auto open = text.find('(');
   if (open != std::string::npos && text.back() == ')') {
     const std::string name = text.substr(0, open);
     if (faults_.invalid_commands.count(name))
       return invalid;
-    const Axis* a = find(text.substr(open + 1, text.size() - open - 2));
+    const std::string argument = text.substr(open + 1, text.size() - open - 2);
+    if (name == "PLANESTATUS")
+      return argument == "0" ? EnsembleResponse{"%" + std::to_string(planeStatus(now_s)), now_s}
+                             : invalid;
+    const Axis* a = find(argument);
     if (!a)
       return invalid;
-    if (name == "PFBK")
+    if (name == "PFBKPROG")
       return {value(positionAt(*a, now_s)), now_s};
     if (name == "VFBK")
       return {value(velocityAt(*a, now_s)), now_s};
@@ -219,7 +223,8 @@ EnsembleResponse EmulatedEnsemble::handle(const std::string& line, double now_s)
       return {"%" + std::to_string(a->fault), now_s};
     if (name == "AXISSTATUS") {
       std::uint32_t bits = 0;
-      const bool moving = a->p0 != a->p1 && now_s < moveEnd(*a);
+      const bool moving =
+          a->p0 != a->p1 && now_s < moveEnd(*a) && now_s >= a->t0 + faults_.axis_status_latency_s;
       if (a->enabled)
         bits |= STATUS_ENABLED;
       if (a->homed)
@@ -297,12 +302,15 @@ EnsembleResponse EmulatedEnsemble::handle(const std::string& line, double now_s)
     const double end = a->fault_at >= 0 ? a->fault_at : moveEnd(*a);
     return {a->fault_at >= 0 ? "#" : "%", end};  // HOME blocks until homed
   }
-  if ((w[0] == "MOVEABS" || w[0] == "MOVEINC") && (w.size() == 3 || w.size() == 5)) {
+  if ((w[0] == "MOVEABS" || w[0] == "MOVEINC") && (w.size() == 3 || w.size() == 4)) {
     double target = 0, velocity = a->config.max_velocity;
     if (!parseDouble(w[2], target))
       return invalid;
-    if (w.size() == 5 &&
-        (w[3] != a->config.name + "F" || !parseDouble(w[4], velocity) || velocity <= 0))
+    // The speed word: the axis as addressed, "F", the value ("XF5", "@1F5").
+    const std::string speed_prefix = w[1] + "F";
+    if (w.size() == 4 &&
+        (w[3].compare(0, speed_prefix.size(), speed_prefix) != 0 ||
+         !parseDouble(w[3].substr(speed_prefix.size()), velocity) || velocity <= 0))
       return invalid;
     if (w[0] == "MOVEINC")
       target += positionAt(*a, now_s);
@@ -322,6 +330,14 @@ EnsembleResponse EmulatedEnsemble::handle(const std::string& line, double now_s)
     return ok;
   }
   return invalid;
+}
+
+std::uint32_t EmulatedEnsemble::planeStatus(double now_s) const {
+  for (const auto& [name, a] : axes_) {
+    if (a.p0 != a.p1 && now_s < moveEnd(a))
+      return PLANE_MOTION_ACTIVE;
+  }
+  return 0;
 }
 
 double EmulatedEnsemble::position(const std::string& axis, double now_s) const {

@@ -31,8 +31,9 @@ TEST(AerotechProtocol, RepliesStatusAndFaults) {
   EXPECT_EQ(describeFaults(0), "none");
   EXPECT_EQ(describeFaults(FAULT_POSITION_ERROR | FAULT_ESTOP), "position error, emergency stop");
   EXPECT_EQ(describeFaults(1u << 9), "bit 9");
-  EXPECT_EQ(command::moveAbsolute("X", 10.0, 5.0), "MOVEABS X 10.000000 XF 5.000000");
-  EXPECT_EQ(command::positionFeedback("@1"), "PFBK(@1)");
+  EXPECT_EQ(command::moveAbsolute("X", 10.0, 5.0), "MOVEABS X 10.000000 XF5.000000");
+  EXPECT_EQ(command::positionFeedback("@1"), "PFBKPROG(@1)");
+  EXPECT_EQ(command::planeStatus(0), "PLANESTATUS(0)");
 }
 
 TEST(AerotechProtocol, LineFramerSplitsCoalescesAndBounds) {
@@ -58,7 +59,7 @@ EmulatedAxisConfig rotary() {
 
 TEST(EmulatedEnsemble, TrapezoidalMovesHomingLimitsAndFaults) {
   EmulatedEnsemble e({rotary()});
-  EXPECT_EQ(e.handle("MOVEABS X 20 XF 10", 0.0).line, "#");  // not enabled
+  EXPECT_EQ(e.handle("MOVEABS X 20 XF10", 0.0).line, "#");  // not enabled
   EXPECT_EQ(e.handle("ENABLE X", 0.0).line, "%");
   // HOME blocks until the axis reaches 0 at 45 deg/s: 10 deg with 0.25 s ramps.
   const EnsembleResponse home = e.handle("HOME X", 0.0);
@@ -67,23 +68,25 @@ TEST(EmulatedEnsemble, TrapezoidalMovesHomingLimitsAndFaults) {
   EXPECT_NEAR(home.ready_at_s, 2.0 * std::sqrt(10.0 / 180.0), 1e-9);
   EXPECT_EQ(e.handle("WAIT MODE NOWAIT", 1.0).line, "%");
   // 90 deg at 90 deg/s with 180 deg/s^2: 0.5 s ramps, 1.5 s in all; half-way at 0.75 s.
-  EXPECT_EQ(e.handle("MOVEABS X 90 XF 90", 1.0).ready_at_s, 1.0);  // NOWAIT: replies at once
+  EXPECT_EQ(e.handle("MOVEABS X 90 XF90", 1.0).ready_at_s, 1.0);  // NOWAIT: replies at once
   EXPECT_NEAR(e.position("X", 1.75), 45.0, 1e-9);
   EXPECT_NEAR(e.position("X", 1.25), 0.5 * 180.0 * 0.25 * 0.25, 1e-9);
   EXPECT_EQ(e.handle("AXISSTATUS(X)", 1.5).line,
             "%" + std::to_string(STATUS_ENABLED | STATUS_HOMED | STATUS_MOVE_ACTIVE));
   EXPECT_NEAR(parseReply(e.handle("VFBK(X)", 1.75).line).number(), 90.0, 0.5);
-  EXPECT_NEAR(parseReply(e.handle("PFBK(X)", 3.0).line).number(), 90.0, 1e-9);
+  EXPECT_NEAR(parseReply(e.handle("PFBKPROG(X)", 3.0).line).number(), 90.0, 1e-9);
   // Past the hard limit: stops there, faulted and disabled.
-  e.handle("MOVEINC X 200 XF 90", 3.0);
+  e.handle("MOVEINC X 200 XF90", 3.0);
   EXPECT_NEAR(e.position("X", 10.0), 180.0, 1e-9);
   EXPECT_EQ(e.handle("AXISFAULT(X)", 10.0).line, "%" + std::to_string(FAULT_POSITIVE_HARD_LIMIT));
   EXPECT_EQ(e.handle("ENABLE X", 10.0).line, "#");  // acknowledge first
   EXPECT_EQ(e.handle("FAULTACK X", 10.0).line, "%");
   EXPECT_EQ(e.handle("ENABLE X", 10.0).line, "%");
   EXPECT_EQ(e.handle("FLY X", 10.0).line, "!");
-  EXPECT_EQ(e.handle("PFBK(Z)", 10.0).line, "!");
+  EXPECT_EQ(e.handle("PFBKPROG(Z)", 10.0).line, "!");
   EXPECT_EQ(e.handle("MOVEABS X abc", 10.0).line, "!");
+  EXPECT_EQ(e.handle("MOVEABS X 10 XF 5", 10.0).line, "!");   // the speed is one word
+  EXPECT_EQ(e.handle("MOVEABS @0 10 @0F5", 10.0).line, "%");  // by index, as motorAerotech
 }
 
 // The client against a served emulator with a rotary axis X and a slide Y.
@@ -125,6 +128,21 @@ TEST(EnsembleClient, EnablesHomesMovesAndReadsBack) {
   rig.client->waitForMove("X", 3.0);
   EXPECT_NEAR(rig.client->position("X"), 25.0, 1e-6);
   EXPECT_EQ(rig.client->reconnects(), 0u);
+}
+
+TEST(EnsembleClient, AMoveIsDoneOnlyWhenItsPlaneIsIdleToo) {
+  // The controller's AXISSTATUS reports the move 0.2 s late; PLANESTATUS at once.
+  EnsembleFaults faults;
+  faults.axis_status_latency_s = 0.2;
+  Rig rig(faults);
+  rig.client->enable("X");
+  rig.client->home("X");
+  rig.client->moveAbsolute("X", 45.0, 90.0);
+  EXPECT_FALSE(rig.client->status("X").moveActive()) << "inside the latency window";
+  EXPECT_TRUE(rig.client->planeMoving());
+  rig.client->waitForMove("X", 3.0);
+  EXPECT_NEAR(rig.client->position("X"), 45.0, 1e-6) << "waited for the move, not the status";
+  EXPECT_FALSE(rig.client->planeMoving());
 }
 
 TEST(EnsembleClient, AFaultMidMoveIsDecoded) {

@@ -57,6 +57,9 @@ constexpr std::uint32_t STATUS_POSITIVE_LIMIT = 1u << 22;
 constexpr std::uint32_t STATUS_NEGATIVE_LIMIT = 1u << 23;
 constexpr std::uint32_t STATUS_ESTOP = 1u << 31;
 
+/// @brief PLANESTATUS bit 0: motion active in the plane.
+constexpr std::uint32_t PLANE_MOTION_ACTIVE = 1u << 0;
+
 /// @brief Bits of AXISFAULT (docs/hardware.md).
 constexpr std::uint32_t FAULT_POSITION_ERROR = 1u << 0;
 constexpr std::uint32_t FAULT_OVER_CURRENT = 1u << 1;
@@ -74,7 +77,9 @@ constexpr std::uint32_t FAULT_COMMUNICATION = 1u << 20;
 /// for 0, and unnamed bits as "fault bit N".
 std::string describeFaults(std::uint32_t bits);
 
-/// @brief Command lines (without the line end) of the commands the driver uses.
+/// @brief Command lines (without the line end) of the commands the driver uses. Moves carry
+/// their speed as one word, axis + "F" + value ("MOVEABS @1 30.000000 @1F5.000000"), the
+/// form the EPICS motorAerotech driver sent to real Ensembles.
 namespace command {
 std::string enable(const std::string& axis);
 std::string disable(const std::string& axis);
@@ -86,7 +91,10 @@ std::string freerun(const std::string& axis, double velocity);
 std::string abort(const std::string& axis);
 std::string faultAck(const std::string& axis);
 std::string acknowledgeAll();
+/// @brief PFBKPROG: position feedback in program coordinates, the ones MOVEABS targets.
 std::string positionFeedback(const std::string& axis);
+/// @brief PLANESTATUS: bit 0 while the plane runs a motion, which AXISSTATUS alone can miss.
+std::string planeStatus(int plane);
 std::string velocityFeedback(const std::string& axis);
 std::string axisStatus(const std::string& axis);
 std::string axisFault(const std::string& axis);

@@ -47,7 +47,10 @@ class EnsembleClient {
   AxisStatus status(const std::string& axis);
   std::uint32_t faults(const std::string& axis);
 
-  /// @brief Poll until the axis is in position with no move active.
+  /// @brief Whether motion plane 0 (the one the ASCII interface's moves run in) is moving.
+  bool planeMoving();
+
+  /// @brief Poll until the axis is in position with no move active, in the axis or its plane.
   /// @throws Error IO_FAILURE on an axis fault (decoded) or when timeout_s passes
   void waitForMove(const std::string& axis, double timeout_s, double poll_s = 0.01);
 

@@ -34,6 +34,9 @@ struct EnsembleFaults {
   std::size_t drop_after_commands = 0;     ///< close the socket after this many commands (0 off)
   std::set<std::string> invalid_commands;  ///< command words answered with '!'
   double idle_timeout_s = 0.0;  ///< close a socket idle this long, as the controller does (0 off)
+  /// AXISSTATUS reports a move this long after it began (before: in position, no move), while
+  /// PLANESTATUS reports it at once: the window a client checking AXISSTATUS alone falls into.
+  double axis_status_latency_s = 0.0;
 };
 
 /// @brief A reply and the time it becomes due (HOME and moves in WAIT MODE MOVEDONE block).
@@ -72,6 +75,7 @@ class EmulatedEnsemble {
   double positionAt(const Axis& axis, double t) const;
   double velocityAt(const Axis& axis, double t) const;
   double moveEnd(const Axis& axis) const;
+  std::uint32_t planeStatus(double now_s) const;
   void settle(Axis& axis, double now_s);
   void startMove(Axis& axis, double target, double velocity, double now_s);
   void stop(Axis& axis, double now_s);
