@@ -105,6 +105,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       parseChecked(*payload, p);
   }
   recordingChecked(bytes);
+  sfaCode(Protocol::COLA_A, bytes);
+  sfaCode(Protocol::COLA_B, bytes);
   static auto source = std::make_shared<PatternSource>();
   for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
     EmulatedLms111 device(EmulatorConfig{}, source);

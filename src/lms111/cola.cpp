@@ -203,6 +203,39 @@ std::string describeSfaError(int code) {
   }
 }
 
+std::optional<int> sfaCode(Protocol protocol, const std::string& payload) {
+  if (payload.compare(0, 3, "sFA") != 0)
+    return std::nullopt;
+  std::size_t pos = 3;
+  if (protocol == Protocol::COLA_A) {
+    if (payload.size() < 5 || payload[3] != ' ')
+      return std::nullopt;
+    const auto code = parseColaNumber(payload.substr(4));
+    if (!code || *code < 0 || *code > 0xFFFF)
+      return std::nullopt;
+    return static_cast<int>(*code);
+  }
+  if (payload.size() == 6 && payload[3] == ' ')
+    pos = 4;
+  if (payload.size() - pos == 2) {
+    return (static_cast<unsigned char>(payload[pos]) << 8) |
+           static_cast<unsigned char>(payload[pos + 1]);
+  }
+  if (payload.size() - pos == 1)
+    return static_cast<unsigned char>(payload[pos]);
+  return std::nullopt;
+}
+
+std::string sfaReply(Protocol protocol, int code) {
+  if (protocol == Protocol::COLA_A) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "sFA %X", static_cast<unsigned>(code) & 0xFFFF);
+    return buf;
+  }
+  return std::string("sFA") + static_cast<char>((code >> 8) & 0xFF) +
+         static_cast<char>(code & 0xFF);
+}
+
 std::string replyTypeOf(const std::string& type) {
   if (type == "sRN")
     return "sRA";

@@ -158,10 +158,7 @@ std::string EmulatedLms111::reply(const EmulatorSession& session, const std::str
 }
 
 std::string EmulatedLms111::sfa(const EmulatorSession& session, int code) const {
-  const auto w = makeWriter(session.protocol);
-  w->word("sFA");
-  w->unsignedValue(static_cast<std::uint64_t>(code), 16);
-  return w->payload();
+  return sfaReply(session.protocol, code);
 }
 
 std::vector<std::string> EmulatedLms111::handle(const std::string& payload,

@@ -118,11 +118,10 @@ class Lms111Driver::Session {
         throw Error(ErrorCode::IO_FAILURE, "no reply to " + type + " " + name + " within " +
                                                std::to_string(timeout) + " s");
       }
+      if (const auto code = sfaCode(c_.protocol, *reply))
+        throw DeviceRefusal(type + " " + name, *code);
       auto r = makeReader(c_.protocol, *reply);
       const std::string got_type = r->word("reply type");
-      if (got_type == "sFA")
-        throw DeviceRefusal(type + " " + name,
-                            static_cast<int>(r->unsignedValue("error code", 16)));
       if (got_type == "sSN")
         continue;
       const std::string got_name = r->word("reply name");

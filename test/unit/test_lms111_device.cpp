@@ -121,11 +121,26 @@ TEST_F(DeviceFixture, ColaBRepliesAndInjectedSfa) {
     w.signedValue(-450000);
     w.signedValue(2250000);
   };
-  auto first = ask_b(set);
-  EXPECT_EQ(first.word("type"), "sFA");
-  EXPECT_EQ(first.unsignedValue("code", 16), 4u);
+  ColaBWriter set_request;
+  set(set_request);
+  const auto first = device.handle(set_request.payload(), b, 10.0);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0], std::string("sFA\x00\x04", 5));  // the code right after "sFA"
+  EXPECT_EQ(sfaCode(Protocol::COLA_B, first[0]), 4);
   auto second = ask_b(set);
   EXPECT_EQ(second.word("type"), "sAN");
+}
+
+TEST(SfaCode, ReadsBothProtocolsAndTheSpacedCoLaBForm) {
+  EXPECT_EQ(sfaCode(Protocol::COLA_A, "sFA 5"), 5);
+  EXPECT_EQ(sfaCode(Protocol::COLA_A, "sFA B"), 11);
+  EXPECT_EQ(sfaCode(Protocol::COLA_B, std::string("sFA\x00\x05", 5)), 5);
+  EXPECT_EQ(sfaCode(Protocol::COLA_B, std::string("sFA \x00\x05", 6)), 5);
+  EXPECT_EQ(sfaCode(Protocol::COLA_B, std::string("sFA\x05", 4)), 5);
+  EXPECT_FALSE(sfaCode(Protocol::COLA_A, "sAN Run 1"));
+  EXPECT_FALSE(sfaCode(Protocol::COLA_A, "sFA x"));
+  EXPECT_EQ(sfaReply(Protocol::COLA_A, 11), "sFA B");
+  EXPECT_EQ(sfaReply(Protocol::COLA_B, 0x0102), std::string("sFA\x01\x02", 5));
 }
 
 TEST(LaserScan, RosAnglesRep117AndIntensities) {

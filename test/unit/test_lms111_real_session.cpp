@@ -162,9 +162,9 @@ TEST(SessionReplay, AnswersWhatTheRecordedHostAskedWithTheRecordedReplies) {
   // A recorded command of another size than the recorded request: buffer under- or overflow.
   ask(*device, s, loginRequest(Protocol::COLA_B));
   const std::string short_cfg = recorded("sWN LMDscandatacfg ").substr(0, 31);
-  EXPECT_EQ(ask(*device, s, short_cfg), std::string("sFA \x00\x08", 6));
+  EXPECT_EQ(ask(*device, s, short_cfg), std::string("sFA\x00\x08", 5));
   EXPECT_EQ(ask(*device, s, recorded("sWN LMDscandatacfg ") + '\0'),
-            std::string("sFA \x00\x07", 6));
+            std::string("sFA\x00\x07", 5));
   // What the recording lacks is answered in the device's layout.
   EXPECT_EQ(ask(*device, s, plainRequest(Protocol::COLA_B, "sRN", "DeviceIdent")).substr(0, 15),
             "sRA DeviceIdent");

@@ -122,6 +122,14 @@ enum SfaCode : int {
   SFA_COLA_A_INVALID_CHARACTER = 17,
 };
 
+/// @brief The error code of an `sFA` reply, nothing for any other payload. CoLa-A: "sFA" and
+/// the code as a token; CoLa-B: "sFA" and the code as a 16-bit value right after it (as the
+/// SOPAS driver of sick_scan_xd reads it from real devices), a space before it tolerated.
+std::optional<int> sfaCode(Protocol protocol, const std::string& payload);
+
+/// @brief An `sFA` reply in the device's layout.
+std::string sfaReply(Protocol protocol, int code);
+
 /// @brief Readable text of an `sFA` error code.
 std::string describeSfaError(int code);
 
