@@ -8,7 +8,7 @@
 namespace dormant_tree_modeling {
 namespace aerotech {
 
-/// @brief First character of every Ensemble ASCII reply (docs/hardware.md).
+/// @brief First character of every Ensemble ASCII reply (docs/protocols.md).
 enum class ReplyStatus : char {
   SUCCESS = '%',
   INVALID = '!',  ///< the controller did not understand the command
@@ -33,7 +33,7 @@ Reply parseReply(const std::string& line);
 /// @brief Readable meaning of a status: "success", "invalid command", ...
 const char* replyStatusName(ReplyStatus status);
 
-/// @brief Bits of AXISSTATUS (docs/hardware.md).
+/// @brief Bits of AXISSTATUS (docs/protocols.md).
 struct AxisStatus {
   std::uint32_t bits = 0;
   bool enabled() const { return bits & (1u << 0); }
@@ -60,7 +60,7 @@ constexpr std::uint32_t STATUS_ESTOP = 1u << 31;
 /// @brief PLANESTATUS bit 0: motion active in the plane.
 constexpr std::uint32_t PLANE_MOTION_ACTIVE = 1u << 0;
 
-/// @brief Bits of AXISFAULT (docs/hardware.md).
+/// @brief Bits of AXISFAULT (docs/protocols.md).
 constexpr std::uint32_t FAULT_POSITION_ERROR = 1u << 0;
 constexpr std::uint32_t FAULT_OVER_CURRENT = 1u << 1;
 constexpr std::uint32_t FAULT_POSITIVE_HARD_LIMIT = 1u << 2;

@@ -17,7 +17,7 @@ enum class Protocol { COLA_A, COLA_B };
 /// @brief "CoLa-A" or "CoLa-B".
 const char* protocolName(Protocol protocol);
 
-/// @brief CoLa-A telegram delimiters (docs/hardware.md).
+/// @brief CoLa-A telegram delimiters (docs/protocols.md).
 constexpr char STX = 0x02;
 constexpr char ETX = 0x03;
 

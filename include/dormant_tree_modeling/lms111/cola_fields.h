@@ -40,7 +40,7 @@ class FieldReader {
 };
 
 /// @brief CoLa-A: space-separated tokens, numbers hexadecimal without prefix or decimal with a
-/// sign (docs/hardware.md).
+/// sign (docs/protocols.md).
 class ColaAReader : public FieldReader {
  public:
   explicit ColaAReader(std::string text) : text_(std::move(text)) {}

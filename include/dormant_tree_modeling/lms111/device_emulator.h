@@ -90,7 +90,7 @@ struct EmulatorSession {
 
 /// @brief The device's command interpreter and state machine, without any I/O: the server
 /// feeds it request payloads and the time, and sends what it returns. Implements the commands
-/// the driver uses (docs/hardware.md): SetAccessMode, mLMPsetscancfg, LMPscancfg,
+/// the driver uses (docs/protocols.md): SetAccessMode, mLMPsetscancfg, LMPscancfg,
 /// LMPoutputRange, LMDscandatacfg, LMCstartmeas, LMCstopmeas, STlms, Run, DeviceIdent,
 /// LMDscandata (event and poll), with `sFA` replies to unknown commands, missing access, wrong
 /// state and bad data.

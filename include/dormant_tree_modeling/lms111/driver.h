@@ -73,7 +73,7 @@ struct StampedScan {
 };
 
 /// @brief The LMS111 Ethernet driver: connects, runs the start-up sequence of
-/// docs/hardware.md with every reply checked, verifies that the device streams what was
+/// docs/protocols.md with every reply checked, verifies that the device streams what was
 /// asked, and delivers stamped scans; on any failure (refused connection, timeout, closed
 /// socket, silent device, sFA, wrong configuration) it logs one clear message, backs off and
 /// starts over, until stop(). Runs in its own thread; callbacks come from that thread.

@@ -54,7 +54,7 @@ struct ScanPosition {
   std::uint8_t rotation_type = 0;
 };
 
-/// @brief A decoded `LMDscandata` telegram (docs/hardware.md lists the fields in order).
+/// @brief A decoded `LMDscandata` telegram (docs/protocols.md lists the fields in order).
 struct ScanTelegram {
   std::string command_type;  ///< sSN (stream) or sRA (polled)
   std::uint16_t version = 0;
