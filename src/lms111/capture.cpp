@@ -58,6 +58,19 @@ bool isDataLine(const std::string& line) {
   return first != std::string::npos && line[first] != '#';
 }
 
+// Records a failed frame, folding it into the previous entry when that one failed too.
+void addFailure(std::vector<CapturedTelegram>& out, std::size_t offset, std::string error) {
+  if (!out.empty() && !out.back().error.empty()) {
+    ++out.back().failures;
+    out.back().last_offset = offset;
+    return;
+  }
+  CapturedTelegram t;
+  t.offset = t.last_offset = offset;
+  t.error = std::move(error);
+  out.push_back(std::move(t));
+}
+
 }  // namespace
 
 std::string readRecording(const std::string& path, const std::string& what) {
@@ -78,36 +91,33 @@ std::vector<CapturedTelegram> cutColaBStream(const std::string& bytes) {
   std::vector<CapturedTelegram> out;
   std::size_t pos = bytes.find(COLA_B_MAGIC);
   while (pos != std::string::npos) {
-    CapturedTelegram t;
-    t.offset = pos;
     if (bytes.size() - pos < COLA_B_HEADER) {
-      t.error = "cut-off frame (no length field)";
-      out.push_back(t);
+      addFailure(out, pos, "cut-off frame (no length field)");
       break;
     }
     std::uint64_t length = 0;
     for (std::size_t i = 4; i < COLA_B_HEADER; ++i)
       length = (length << 8) | static_cast<unsigned char>(bytes[pos + i]);
     if (length + 1 > bytes.size() - pos - COLA_B_HEADER) {
-      t.error = "cut-off frame (" + std::to_string(length) + " payload bytes declared, " +
-                std::to_string(bytes.size() - pos - COLA_B_HEADER) + " left)";
-      out.push_back(t);
+      addFailure(out, pos,
+                 "cut-off frame (" + std::to_string(length) + " payload bytes declared, " +
+                     std::to_string(bytes.size() - pos - COLA_B_HEADER) + " left)");
       // A corrupt length can swallow good frames: resynchronise just past this magic.
       pos = bytes.find(COLA_B_MAGIC, pos + 1);
       continue;
     }
-    const std::string payload = bytes.substr(pos + COLA_B_HEADER, length);
-    char sum = 0;
-    for (const char c : payload)
-      sum = static_cast<char>(sum ^ c);
     const std::size_t end = pos + COLA_B_HEADER + length + 1;
+    char sum = 0;
+    for (std::size_t i = pos + COLA_B_HEADER; i + 1 < end; ++i)
+      sum = static_cast<char>(sum ^ bytes[i]);
     if (sum != bytes[end - 1]) {
-      t.error = "bad checksum";
-      out.push_back(t);
+      addFailure(out, pos, "bad checksum");
       pos = bytes.find(COLA_B_MAGIC, pos + 1);
       continue;
     }
-    t.payload = payload;
+    CapturedTelegram t;
+    t.offset = t.last_offset = pos;
+    t.payload = bytes.substr(pos + COLA_B_HEADER, length);
     out.push_back(std::move(t));
     pos = bytes.find(COLA_B_MAGIC, end);
   }
@@ -119,15 +129,15 @@ std::vector<CapturedTelegram> cutColaAStream(const std::string& bytes) {
   std::size_t pos = bytes.find(STX);
   while (pos != std::string::npos) {
     const std::size_t end = bytes.find_first_of(std::string{STX, ETX}, pos + 1);
-    CapturedTelegram t;
-    t.offset = pos;
     if (end == std::string::npos || bytes[end] == STX) {
-      t.error = "cut-off telegram (no ETX before the " +
-                std::string(end == std::string::npos ? "end" : "next STX") + ")";
-      out.push_back(t);
+      addFailure(out, pos,
+                 "cut-off telegram (no ETX before the " +
+                     std::string(end == std::string::npos ? "end" : "next STX") + ")");
       pos = end;
       continue;
     }
+    CapturedTelegram t;
+    t.offset = t.last_offset = pos;
     t.payload = bytes.substr(pos + 1, end - pos - 1);
     out.push_back(std::move(t));
     pos = bytes.find(STX, end + 1);

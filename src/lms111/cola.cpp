@@ -49,43 +49,55 @@ std::string frameColaB(const std::string& payload) {
   return out;
 }
 
+// Both framers consume their buffer through a read position and compact it only when the
+// consumed part is at least half of it, so that resynchronising byte by byte (a flood of STX
+// or of magic bytes) stays linear in the input.
+namespace {
+
+void compact(std::string& buffer, std::size_t& pos) {
+  if (pos > 0 && pos * 2 >= buffer.size()) {
+    buffer.erase(0, pos);
+    pos = 0;
+  }
+}
+
+}  // namespace
+
 void ColaAFramer::feed(const char* data, std::size_t size) {
   buffer_.append(data, size);
 }
 
 std::optional<std::string> ColaAFramer::next() {
   for (;;) {
-    const std::size_t start = buffer_.find(STX);
+    const std::size_t start = buffer_.find(STX, pos_);
     if (start == std::string::npos) {
-      skipped_ += buffer_.size();
+      skipped_ += buffer_.size() - pos_;
       buffer_.clear();
+      pos_ = 0;
       return std::nullopt;
     }
-    if (start > 0) {
-      skipped_ += start;
-      buffer_.erase(0, start);
-    }
+    skipped_ += start - pos_;
+    pos_ = start;
     // A second STX before the ETX means the first telegram was cut short: restart there.
-    const std::size_t end = buffer_.find_first_of(std::string{STX, ETX}, 1);
+    const std::size_t end = buffer_.find_first_of(std::string{STX, ETX}, pos_ + 1);
     if (end == std::string::npos) {
-      if (buffer_.size() > max_telegram_) {
+      if (buffer_.size() - pos_ > max_telegram_) {
         ++dropped_;
         buffer_.clear();
+        pos_ = 0;
       }
+      compact(buffer_, pos_);
       return std::nullopt;
     }
-    if (buffer_[end] == STX) {
+    if (buffer_[end] == STX || end - pos_ - 1 > max_telegram_) {
       ++dropped_;
-      buffer_.erase(0, end);
+      pos_ = buffer_[end] == STX ? end : end + 1;
+      compact(buffer_, pos_);
       continue;
     }
-    if (end - 1 > max_telegram_) {
-      ++dropped_;
-      buffer_.erase(0, end + 1);
-      continue;
-    }
-    std::string telegram = buffer_.substr(1, end - 1);
-    buffer_.erase(0, end + 1);
+    std::string telegram = buffer_.substr(pos_ + 1, end - pos_ - 1);
+    pos_ = end + 1;
+    compact(buffer_, pos_);
     return telegram;
   }
 }
@@ -95,45 +107,51 @@ void ColaBFramer::feed(const char* data, std::size_t size) {
 }
 
 std::optional<std::string> ColaBFramer::next() {
+  const std::string magic(COLA_B_MAGIC, 4);
   for (;;) {
-    const std::size_t start = buffer_.find(std::string(COLA_B_MAGIC, 4));
+    const std::size_t start = buffer_.find(magic, pos_);
     if (start == std::string::npos) {
       // Keep a possible beginning of the magic at the end.
       std::size_t keep = 0;
-      while (keep < 3 && keep < buffer_.size() &&
+      while (keep < 3 && keep < buffer_.size() - pos_ &&
              buffer_[buffer_.size() - 1 - keep] == COLA_B_MAGIC[0])
         ++keep;
-      skipped_ += buffer_.size() - keep;
+      skipped_ += buffer_.size() - pos_ - keep;
       buffer_.erase(0, buffer_.size() - keep);
+      pos_ = 0;
       return std::nullopt;
     }
-    if (start > 0) {
-      skipped_ += start;
-      buffer_.erase(0, start);
-    }
-    if (buffer_.size() < 8)
+    skipped_ += start - pos_;
+    pos_ = start;
+    if (buffer_.size() - pos_ < 8) {
+      compact(buffer_, pos_);
       return std::nullopt;
+    }
     std::uint32_t length = 0;
-    for (int i = 4; i < 8; ++i)
-      length = (length << 8) | static_cast<unsigned char>(buffer_[i]);
+    for (std::size_t i = 4; i < 8; ++i)
+      length = (length << 8) | static_cast<unsigned char>(buffer_[pos_ + i]);
     if (length > max_payload_) {
       ++dropped_;
-      buffer_.erase(0, 1);  // resynchronise on the next magic
+      ++pos_;  // resynchronise on the next magic
       continue;
     }
-    if (buffer_.size() < 8 + static_cast<std::size_t>(length) + 1)
+    if (buffer_.size() - pos_ < 8 + static_cast<std::size_t>(length) + 1) {
+      compact(buffer_, pos_);
       return std::nullopt;
-    std::string payload = buffer_.substr(8, length);
+    }
+    const char* payload = buffer_.data() + pos_ + 8;
     char sum = 0;
-    for (const char c : payload)
-      sum = static_cast<char>(sum ^ c);
-    if (sum != buffer_[8 + length]) {
+    for (std::uint32_t i = 0; i < length; ++i)
+      sum = static_cast<char>(sum ^ payload[i]);
+    if (sum != payload[length]) {
       ++bad_checksum_;
-      buffer_.erase(0, 1);
+      ++pos_;
       continue;
     }
-    buffer_.erase(0, 8 + static_cast<std::size_t>(length) + 1);
-    return payload;
+    std::string out(payload, length);
+    pos_ += 8 + static_cast<std::size_t>(length) + 1;
+    compact(buffer_, pos_);
+    return out;
   }
 }
 

@@ -115,8 +115,13 @@ int decodeAll(const std::string& data, bool summary) {
   std::size_t good = 0, bad = 0;
   for (const auto& t : r.telegrams) {
     if (!t.error.empty()) {
-      std::cerr << "lms111_decode: " << where(t) << ": " << t.error << "\n";
-      ++bad;
+      std::cerr << "lms111_decode: " << where(t) << ": " << t.error;
+      if (t.failures > 1) {
+        std::cerr << " (and " << t.failures - 1 << " more failed frames up to offset "
+                  << t.last_offset << ")";
+      }
+      std::cerr << "\n";
+      bad += t.failures;
     } else if (decodeOne(t, r.protocol, summary, bare)) {
       ++good;
     } else {

@@ -163,8 +163,7 @@ TEST(SessionReplay, AnswersWhatTheRecordedHostAskedWithTheRecordedReplies) {
   ask(*device, s, loginRequest(Protocol::COLA_B));
   const std::string short_cfg = recorded("sWN LMDscandatacfg ").substr(0, 31);
   EXPECT_EQ(ask(*device, s, short_cfg), std::string("sFA\x00\x08", 5));
-  EXPECT_EQ(ask(*device, s, recorded("sWN LMDscandatacfg ") + '\0'),
-            std::string("sFA\x00\x07", 5));
+  EXPECT_EQ(ask(*device, s, recorded("sWN LMDscandatacfg ") + '\0'), std::string("sFA\x00\x07", 5));
   // What the recording lacks is answered in the device's layout.
   EXPECT_EQ(ask(*device, s, plainRequest(Protocol::COLA_B, "sRN", "DeviceIdent")).substr(0, 15),
             "sRA DeviceIdent");
@@ -273,6 +272,28 @@ TEST(Capture, ReportsBadChecksumsAndCutOffFramesWithTheirOffsetsAndGoesOn) {
   EXPECT_NE(a[1].error.find("cut-off"), std::string::npos);
   EXPECT_EQ(a[2].payload, "sEA LMDscandata 1");
   EXPECT_NE(a[3].error.find("cut-off"), std::string::npos);
+}
+
+TEST(Capture, AFloodOfFrameStartsIsOneFindingAndLinearToCut) {
+  // 2 MB of STX or magic bytes: one folded finding each (quadratic cutting took minutes).
+  const std::string flood(2u << 20, '\x02');
+  const auto a = cutColaAStream(flood);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].failures, flood.size());
+  EXPECT_EQ(a[0].last_offset, flood.size() - 1);
+  const auto b = cutColaBStream(flood + frameColaB("sAN Run \x01"));
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_FALSE(b[0].error.empty());
+  EXPECT_EQ(b[1].payload, "sAN Run \x01") << "the frame after the flood";
+  for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
+    auto framer = makeFramer(p);
+    framer->feed(flood);
+    framer->feed(frame(p, "sAN Run 1"));
+    const auto got = framer->next();
+    ASSERT_TRUE(got.has_value()) << protocolName(p);
+    EXPECT_EQ(*got, "sAN Run 1");
+    EXPECT_GE(framer->discarded(), 1u);
+  }
 }
 
 TEST(Capture, ASessionLineThatIsNotSecondsAndHexIsAParseErrorNamingTheLine) {

@@ -15,6 +15,10 @@ struct CapturedTelegram {
   double time_s = -1.0;    ///< capture time (session files), -1 when the recording has none
   std::string payload;     ///< the telegram without framing; empty when `error` is set
   std::string error;       ///< "bad checksum", "cut-off frame", ...; empty for a good telegram
+  /// Failed frames this entry stands for: findings with no good telegram between them are
+  /// folded into the first (a flood of magic bytes is one entry, not one per byte).
+  std::size_t failures = 1;
+  std::size_t last_offset = 0;  ///< offset of the last folded failure
 };
 
 /// @brief The bytes of a recording.

@@ -66,12 +66,16 @@ class ColaAFramer : public Framer {
 
   std::size_t skippedBytes() const { return skipped_; }      ///< garbage before an STX
   std::size_t droppedTelegrams() const { return dropped_; }  ///< over the bound
-  std::size_t buffered() const { return buffer_.size(); }
-  void clear() override { buffer_.clear(); }
+  std::size_t buffered() const { return buffer_.size() - pos_; }
+  void clear() override {
+    buffer_.clear();
+    pos_ = 0;
+  }
 
  private:
   std::size_t max_telegram_;
   std::string buffer_;
+  std::size_t pos_ = 0;  // bytes of buffer_ already consumed
   std::size_t skipped_ = 0, dropped_ = 0;
 };
 
@@ -85,7 +89,10 @@ class ColaBFramer : public Framer {
   /// @brief The next payload whose checksum is right, if any.
   std::optional<std::string> next() override;
   std::size_t discarded() const override { return skipped_ + bad_checksum_ + dropped_; }
-  void clear() override { buffer_.clear(); }
+  void clear() override {
+    buffer_.clear();
+    pos_ = 0;
+  }
   std::size_t skippedBytes() const { return skipped_; }
   std::size_t badChecksums() const { return bad_checksum_; }
   std::size_t droppedFrames() const { return dropped_; }  ///< declared length over the bound
@@ -93,6 +100,7 @@ class ColaBFramer : public Framer {
  private:
   std::size_t max_payload_;
   std::string buffer_;
+  std::size_t pos_ = 0;  // bytes of buffer_ already consumed
   std::size_t skipped_ = 0, bad_checksum_ = 0, dropped_ = 0;
 };
 
