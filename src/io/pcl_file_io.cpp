@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <optional>
@@ -89,42 +90,138 @@ bool isCount(const std::string& s) {
   throw Error(ErrorCode::PARSE_ERROR, path + ": " + why);
 }
 
+// What a PCD header promises, to hold against the file before any reader allocates.
+struct PcdLayout {
+  std::vector<std::uint64_t> sizes, counts;
+  std::uint64_t width = 0, height = 1, points = 0;
+  bool has_width = false, has_points = false;
+  std::string data;
+  std::uint64_t header_bytes = 0;  // bytes up to and including the DATA line
+
+  // Bytes of one point, or nothing when the sum does not fit 64 bits.
+  std::optional<std::uint64_t> pointBytes() const {
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < sizes.size(); ++i) {
+      if (counts[i] != 0 && sizes[i] > UINT64_MAX / counts[i])
+        return std::nullopt;
+      const std::uint64_t field = sizes[i] * counts[i];
+      if (total > UINT64_MAX - field)
+        return std::nullopt;
+      total += field;
+    }
+    return total;
+  }
+};
+
+// The least a binary_compressed file can compress to: LZF (PCL's codec) writes at least
+// 3 bytes for every 264 bytes of a run.
+constexpr std::uint64_t MAX_LZF_RATIO = 88;
+
+std::vector<std::uint64_t> countsOf(const std::string& path, const std::vector<std::string>& t) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (!isCount(t[i]))
+      malformed(path, "PCD " + t[0] + " holds '" + t[i] + "', not a count");
+    out.push_back(std::stoull(t[i]));
+  }
+  return out;
+}
+
+void readPcdHeaderLine(const std::string& path, const std::string& line, PcdLayout& h,
+                       std::size_t& fields) {
+  const auto t = tokens(line);
+  if (t.empty() || t[0][0] == '#')
+    return;
+  const std::string& key = t[0];
+  if (key == "VERSION" || key == "VIEWPOINT")
+    return;
+  if (key == "FIELDS") {
+    fields = t.size() - 1;
+  } else if (key == "SIZE" || key == "TYPE" || key == "COUNT") {
+    if (fields == 0 || t.size() - 1 != fields)
+      malformed(path, "PCD " + key + " does not match FIELDS");
+    if (key == "SIZE")
+      h.sizes = countsOf(path, t);
+    if (key == "COUNT")
+      h.counts = countsOf(path, t);
+  } else if (key == "WIDTH" || key == "HEIGHT" || key == "POINTS") {
+    if (t.size() != 2 || !isCount(t[1]))
+      malformed(path, "PCD " + key + " is not a count");
+    const std::uint64_t v = std::stoull(t[1]);
+    (key == "WIDTH" ? h.width : key == "HEIGHT" ? h.height : h.points) = v;
+    h.has_width = h.has_width || key == "WIDTH";
+    h.has_points = h.has_points || key == "POINTS";
+  } else if (key == "DATA") {
+    if (t.size() != 2 || (t[1] != "ascii" && t[1] != "binary" && t[1] != "binary_compressed"))
+      malformed(path, "PCD DATA must be ascii, binary or binary_compressed");
+    if (fields == 0 || !h.has_width || !h.has_points)
+      malformed(path, "PCD header lacks FIELDS, WIDTH or POINTS");
+    h.data = t[1];
+  } else {
+    malformed(path, "not a PCD file (unexpected header line '" + line.substr(0, 40) + "')");
+  }
+}
+
+// The points the header promises must fit in the bytes the file has: a 178-byte file must
+// not make a reader allocate gigabytes.
+void checkPcdAgainstFile(const std::string& path, std::ifstream& in, PcdLayout& h,
+                         std::uint64_t file_bytes) {
+  if (h.counts.empty())
+    h.counts.assign(h.sizes.size(), 1);  // COUNT is optional: one value per field
+  if (h.sizes.empty() || h.sizes.size() != h.counts.size())
+    malformed(path, "PCD header lacks SIZE");
+  if (h.height == 0 || h.points % h.height != 0 || h.points / h.height != h.width)
+    malformed(path, "PCD WIDTH x HEIGHT is not POINTS");
+  const auto point_bytes = h.pointBytes();
+  const std::uint64_t body = file_bytes - h.header_bytes;
+  const auto too_large = [&](std::uint64_t need) {
+    malformed(path, "the header promises " + std::to_string(h.points) + " points (" +
+                        std::to_string(need) + " bytes) but the file holds " +
+                        std::to_string(body) + " bytes of data");
+  };
+  if (!point_bytes || (*point_bytes != 0 && h.points > UINT64_MAX / *point_bytes))
+    too_large(UINT64_MAX);
+  const std::uint64_t need = h.points * *point_bytes;
+  if (h.data == "binary" && need > body)
+    too_large(need);
+  // ASCII: at least one character and a separator per value.
+  std::uint64_t values = 0;
+  for (const auto c : h.counts)
+    values += c;
+  if (h.data == "ascii" && h.points > 0 && values > body / h.points / 2 + 1)
+    too_large(need);
+  if (h.data == "binary_compressed") {
+    std::uint32_t sizes[2] = {0, 0};
+    in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
+    if (!in)
+      malformed(path, "binary_compressed PCD without its size fields");
+    if (sizes[1] != need)
+      malformed(path, "binary_compressed PCD: " + std::to_string(sizes[1]) +
+                          " uncompressed bytes declared, the header's points need " +
+                          std::to_string(need));
+    if (sizes[0] > body - sizeof sizes || sizes[1] > MAX_LZF_RATIO * sizes[0] + 1024)
+      too_large(need);
+  }
+}
+
 // PCL 1.13's readers dereference header fields they never validated (a text file that is not
 // a PCD crashes PCDReader::read), so the header is checked here before PCL sees the file.
 void checkPcdHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
-    throw Error(ErrorCode::IO_FAILURE, "cannot open " + path);
+    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot open " + path);
+  in.seekg(0, std::ios::end);
+  const auto file_bytes = static_cast<std::uint64_t>(in.tellg());
+  in.seekg(0);
+  PcdLayout h;
   std::size_t fields = 0;
-  bool has_points = false;
-  bool has_width = false;
   std::string line;
   for (int n = 0; n < 64 && std::getline(in, line); ++n) {
-    const auto t = tokens(line);
-    if (t.empty() || t[0][0] == '#')
-      continue;
-    const std::string& key = t[0];
-    if (key == "VERSION" || key == "VIEWPOINT" || key == "HEIGHT")
-      continue;
-    if (key == "FIELDS") {
-      fields = t.size() - 1;
-    } else if (key == "SIZE" || key == "TYPE" || key == "COUNT") {
-      if (fields == 0 || t.size() - 1 != fields)
-        malformed(path, "PCD " + key + " does not match FIELDS");
-    } else if (key == "WIDTH" || key == "POINTS") {
-      if (t.size() != 2 || !isCount(t[1]))
-        malformed(path, "PCD " + key + " is not a count");
-      (key == "WIDTH" ? has_width : has_points) = true;
-    } else if (key == "DATA") {
-      if (t.size() != 2 || (t[1] != "ascii" && t[1] != "binary" && t[1] != "binary_compressed")) {
-        malformed(path, "PCD DATA must be ascii, binary or binary_compressed");
-      }
-      if (fields == 0 || !has_width || !has_points) {
-        malformed(path, "PCD header lacks FIELDS, WIDTH or POINTS");
-      }
+    readPcdHeaderLine(path, line, h, fields);
+    if (!h.data.empty()) {
+      h.header_bytes = static_cast<std::uint64_t>(in.tellg());
+      checkPcdAgainstFile(path, in, h, file_bytes);
       return;
-    } else {
-      malformed(path, "not a PCD file (unexpected header line '" + line.substr(0, 40) + "')");
     }
   }
   malformed(path, "not a PCD file (no DATA line in the header)");
@@ -133,7 +230,7 @@ void checkPcdHeader(const std::string& path) {
 void checkPlyHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
-    throw Error(ErrorCode::IO_FAILURE, "cannot open " + path);
+    throw Error(ErrorCode::FILE_NOT_FOUND, "cannot open " + path);
   std::string line;
   if (!std::getline(in, line) || tokens(line) != std::vector<std::string>{"ply"}) {
     malformed(path, "not a PLY file (first line is not 'ply')");
@@ -202,7 +299,7 @@ void writePcd(const std::string& path, const Cloud& cloud) {
 
 }  // namespace
 
-RawPoints readPclFile(const std::string& path, bool is_ply) {
+RawPoints readPclFile(const std::string& path, bool is_ply, bool* single_precision) {
   if (is_ply) {
     checkPlyHeader(path);
   } else {
@@ -222,6 +319,11 @@ RawPoints readPclFile(const std::string& path, bool is_ply) {
   const auto fz = findField(blob, "z");
   if (!fx || !fy || !fz)
     malformed(path, "no x/y/z fields");
+  if (single_precision) {
+    *single_precision = fx->datatype == pcl::PCLPointField::FLOAT32 ||
+                        fy->datatype == pcl::PCLPointField::FLOAT32 ||
+                        fz->datatype == pcl::PCLPointField::FLOAT32;
+  }
   const std::size_t n = static_cast<std::size_t>(blob.width) * blob.height;
   for (const auto* f : {&*fx, &*fy, &*fz}) {
     const std::size_t size = scalarSize(f->datatype);

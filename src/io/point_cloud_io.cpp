@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "dormant_tree_modeling/common/error.h"
@@ -39,23 +40,69 @@ CloudFormat cloudFormatFromPath(const std::string& path) {
                   " (expected .pcd, .ply, or text .xyz/.txt/.pts/.asc/.csv)");
 }
 
+namespace {
+
+// Sample size for the offset's quantiles.
+constexpr std::size_t OFFSET_SAMPLE = 100000;
+// The ground's quantile: the offset's z sits at the bottom of the bulk.
+constexpr double OFFSET_Z_QUANTILE = 0.01;
+
+// The offset that brings survey coordinates near the origin: the median in x and y and a low
+// quantile in z, of a sample, so that one stray point cannot move it; whole metres, so that it
+// is exact in any printed form.
+Eigen::Vector3d recentringOffset(const detail::RawPoints& pts) {
+  const std::size_t stride = std::max<std::size_t>(1, pts.size() / OFFSET_SAMPLE);
+  Eigen::Vector3d offset;
+  std::vector<double> v;
+  for (int a = 0; a < 3; ++a) {
+    v.clear();
+    for (std::size_t i = 0; i < pts.size(); i += stride)
+      v.push_back(pts[i](a));
+    const double q = a == 2 ? OFFSET_Z_QUANTILE : 0.5;
+    const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    offset(a) = std::round(v[k]);
+  }
+  return offset;
+}
+
+// float32 steps exceed 1 mm from 2^13 m on: a cloud stored so far from its origin lost the
+// millimetres the diameters need before it was read (steps of 62.5 mm at 600 km).
+constexpr double FLOAT32_MILLIMETRE_LIMIT_M = 8192.0;
+
+[[noreturn]] void refuseCoarseFloats(const std::string& path, double max_abs) {
+  const double step = std::ldexp(1.0, std::ilogb(max_abs) - 23);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.0f m, where float32 steps are %.1f mm", max_abs, 1000.0 * step);
+  throw Error(ErrorCode::PARSE_ERROR,
+              path + ": x/y/z are stored as float32 and reach " + buf +
+                  ": the millimetres were lost when the file was written. Store the "
+                  "coordinates as float64 (PCD SIZE 8, PLY double), or subtract an offset "
+                  "before saving");
+}
+
+}  // namespace
+
 CloudReadResult readCloud(const std::string& path, const CloudReadOptions& options) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw Error(ErrorCode::FILE_NOT_FOUND, path + " is a directory, not a point cloud file");
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw Error(ErrorCode::FILE_NOT_FOUND, "no such file: " + path);
   }
   CloudReadResult result;
   result.format = cloudFormatFromPath(path);
   detail::RawPoints raw;
+  bool single_precision = false;
   switch (result.format) {
     case CloudFormat::XYZ:
       raw = detail::readXyzText(path);
       break;
     case CloudFormat::PCD:
-      raw = detail::readPclFile(path, false);
+      raw = detail::readPclFile(path, false, &single_precision);
       break;
     case CloudFormat::PLY:
-      raw = detail::readPclFile(path, true);
+      raw = detail::readPclFile(path, true, &single_precision);
       break;
   }
   result.points_in_file = raw.size();
@@ -76,18 +123,12 @@ CloudReadResult readCloud(const std::string& path, const CloudReadOptions& optio
   }
 
   double max_abs = 0.0;
-  Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d max = -min;
-  for (const auto& p : finite) {
+  for (const auto& p : finite)
     max_abs = std::max(max_abs, p.cwiseAbs().maxCoeff());
-    min = min.cwiseMin(p);
-    max = max.cwiseMax(p);
-  }
-  if (!finite.empty() && max_abs > options.recenter_threshold) {
-    // Round the offset to whole metres so that it is exact in any printed form.
-    result.offset = (0.5 * (min + max)).array().round().matrix();
-    result.offset.z() = std::round(min.z());
-  }
+  if (single_precision && max_abs >= FLOAT32_MILLIMETRE_LIMIT_M)
+    refuseCoarseFloats(path, max_abs);
+  if (!finite.empty() && max_abs > options.recenter_threshold)
+    result.offset = recentringOffset(finite);
 
   result.cloud = std::make_shared<Cloud>();
   result.cloud->reserve(finite.size());

@@ -25,7 +25,8 @@ RawPoints readXyzText(const std::string& path);
 void writeXyzText(const std::string& path, const Cloud& cloud, const Eigen::Vector3d& offset);
 
 /// @brief Read the x/y/z fields of a PCD or PLY file (float32, float64 or integer fields).
-RawPoints readPclFile(const std::string& path, bool is_ply);
+/// @param single_precision set to whether any of x/y/z is stored as float32
+RawPoints readPclFile(const std::string& path, bool is_ply, bool* single_precision = nullptr);
 
 /// @brief Write a binary PCD or binary PLY file.
 void writePclFile(const std::string& path, const Cloud& cloud, const Eigen::Vector3d& offset,

@@ -26,10 +26,17 @@ constexpr double GROUND_BAND = 0.03;          // m above the ground plane remove
 constexpr double GROUND_MIN_EXTENT = 0.8;     // m: a plane smaller than this is not the ground
 constexpr std::size_t GROUND_SAMPLE = 50000;  // low points that score a ground hypothesis
 constexpr double SPACING_CELL = 0.02;         // m, grid of medianSpacing() without an index
-constexpr double WIRE_BAND = 0.025;           // m around a wire line: its noisy returns
-constexpr double WIRE_NEIGHBOURHOOD = 0.10;   // m, for the linearity test
-constexpr double WIRE_LINEARITY = 0.1;        // second / first eigenvalue below this: a line
-constexpr double WIRE_MAX_GAP = 0.35;         // m: a wire's returns are never sparser than this
+// Far outliers: the bulk's box is the 1st to 99th percentile on each axis (from a sample of
+// at most FAR_OUTLIER_SAMPLE points); a point more than FAR_OUTLIER_MARGIN box extents (and at
+// least FAR_OUTLIER_MIN_MARGIN_M) outside it is a stray, not a part of an orchard scene.
+constexpr double FAR_OUTLIER_QUANTILE = 0.01;
+constexpr double FAR_OUTLIER_MARGIN = 10.0;
+constexpr double FAR_OUTLIER_MIN_MARGIN_M = 100.0;
+constexpr std::size_t FAR_OUTLIER_SAMPLE = 100000;
+constexpr double WIRE_BAND = 0.025;          // m around a wire line: its noisy returns
+constexpr double WIRE_NEIGHBOURHOOD = 0.10;  // m, for the linearity test
+constexpr double WIRE_LINEARITY = 0.1;       // second / first eigenvalue below this: a line
+constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sparser than this
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr double WIRE_MAX_CROSSING = 10.0 * M_PI / 180.0;  // from the row's direction
 constexpr int MAX_WIRES = 10;
@@ -324,6 +331,35 @@ std::vector<char> floatingMaskWith(const Points& pts, double radius, int min_nei
 
 }  // namespace
 
+std::size_t removeFarOutliers(Points& pts) {
+  if (pts.size() < 2)
+    return 0;
+  const std::size_t stride = std::max<std::size_t>(1, pts.size() / FAR_OUTLIER_SAMPLE);
+  Eigen::Vector3d lo, hi;
+  std::vector<double> values;
+  for (int a = 0; a < 3; ++a) {
+    values.clear();
+    for (std::size_t i = 0; i < pts.size(); i += stride)
+      values.push_back(pts[i](a));
+    const auto at = [&](double q) {
+      const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1));
+      std::nth_element(values.begin(), values.begin() + k, values.end());
+      return values[k];
+    };
+    lo(a) = at(FAR_OUTLIER_QUANTILE);
+    hi(a) = at(1.0 - FAR_OUTLIER_QUANTILE);
+  }
+  const Eigen::Vector3d margin = (FAR_OUTLIER_MARGIN * (hi - lo))
+                                     .cwiseMax(Eigen::Vector3d::Constant(FAR_OUTLIER_MIN_MARGIN_M));
+  const Eigen::Vector3d min = lo - margin, max = hi + margin;
+  const auto far = [&](const Eigen::Vector3d& p) {
+    return (p.array() < min.array()).any() || (p.array() > max.array()).any();
+  };
+  const std::size_t before = pts.size();
+  pts.erase(std::remove_if(pts.begin(), pts.end(), far), pts.end());
+  return before - pts.size();
+}
+
 double medianSpacing(const Points& pts) {
   if (pts.size() < 2)
     return 0.0;
@@ -370,7 +406,9 @@ std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbo
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats) {
   PreprocessStats s;
   s.input = pts.size();
-  Points out = voxelDownsample(pts, config.voxel_size);
+  Points bulk = pts;
+  s.far_outliers = removeFarOutliers(bulk);
+  Points out = voxelDownsample(bulk, config.voxel_size);
   s.after_voxel = out.size();
   if (config.ours_remove_clutter) {
     double radius = config.floating_radius;

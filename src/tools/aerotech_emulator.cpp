@@ -54,5 +54,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "aerotech_emulator: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("aerotech_emulator", e);
   }
 }

@@ -112,5 +112,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "calibrate_diameters: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("calibrate_diameters", e);
   }
 }

@@ -1,7 +1,14 @@
 #pragma once
 
+#include <cxxabi.h>
+
 #include <boost/program_options.hpp>
+#include <cstdlib>
+#include <exception>
 #include <iostream>
+#include <memory>
+#include <string>
+#include <typeinfo>
 
 namespace dormant_tree_modeling {
 namespace tools {
@@ -23,6 +30,20 @@ inline bool parseOrHelp(int argc, char** argv,
   }
   po::notify(vm);
   return false;
+}
+
+/// @brief Exit status of a tool for an exception nothing more specific caught.
+constexpr int EXIT_UNEXPECTED = 1;
+
+/// @brief The last handler of every tool's main: reports the exception's type and message and
+/// returns EXIT_UNEXPECTED, so that no exception ends a tool with an abort.
+inline int reportUnexpected(const char* tool, const std::exception& e) {
+  int status = 0;
+  const std::unique_ptr<char, void (*)(void*)> name(
+      abi::__cxa_demangle(typeid(e).name(), nullptr, nullptr, &status), std::free);
+  std::cerr << tool << ": unexpected " << (status == 0 ? name.get() : typeid(e).name()) << ": "
+            << e.what() << "\n";
+  return EXIT_UNEXPECTED;
 }
 
 }  // namespace tools

@@ -52,5 +52,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "evaluate_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("evaluate_model", e);
   }
 }

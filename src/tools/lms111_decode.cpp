@@ -5,7 +5,6 @@
 #include <iostream>
 #include <iterator>
 #include <string>
-#include <typeinfo>
 #include <vector>
 
 #include "command_line.h"
@@ -171,7 +170,6 @@ int main(int argc, char** argv) {
     std::cerr << "lms111_decode: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return e.code() == ErrorCode::FILE_NOT_FOUND ? EXIT_NO_FILE : EXIT_BAD_DATA;
   } catch (const std::exception& e) {
-    std::cerr << "lms111_decode: unexpected " << typeid(e).name() << ": " << e.what() << "\n";
-    return 1;
+    return tools::reportUnexpected("lms111_decode", e);
   }
 }

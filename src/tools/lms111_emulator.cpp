@@ -2,7 +2,6 @@
 // orchard, replaying a recorded telegram or a whole recorded session, with fault injection.
 #include <boost/program_options.hpp>
 #include <iostream>
-#include <typeinfo>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
@@ -117,7 +116,6 @@ int main(int argc, char** argv) {
     std::cerr << "lms111_emulator: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
   } catch (const std::exception& e) {
-    std::cerr << "lms111_emulator: unexpected " << typeid(e).name() << ": " << e.what() << "\n";
-    return 1;
+    return tools::reportUnexpected("lms111_emulator", e);
   }
 }

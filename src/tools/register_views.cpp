@@ -84,5 +84,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "register_views: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("register_views", e);
   }
 }

@@ -55,5 +55,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "render_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return 7;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("render_model", e);
   }
 }

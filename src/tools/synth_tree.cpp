@@ -57,5 +57,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     std::cerr << "synth_tree: " << e.what() << "\n";
     return 3;
+  } catch (const std::exception& e) {
+    return tools::reportUnexpected("synth_tree", e);
   }
 }

@@ -70,6 +70,10 @@ int main(int argc, char** argv) {
       std::cerr << "tree_model: dropped " << cloud.dropped_non_finite << " NaN/Inf points\n";
     }
     const auto result = modeler.model(*cloud.cloud);
+    if (result.preprocess.far_outliers > 0) {
+      std::cerr << "tree_model: dropped " << result.preprocess.far_outliers
+                << " stray points far outside the cloud's bulk\n";
+    }
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));
     if (!csv.empty())
       io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));
@@ -108,7 +112,6 @@ int main(int argc, char** argv) {
     std::cerr << "tree_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
     return exitCode(e.code());
   } catch (const std::exception& e) {
-    std::cerr << "tree_model: internal error: " << e.what() << "\n";
-    return 1;
+    return tools::reportUnexpected("tree_model", e);
   }
 }

@@ -159,6 +159,11 @@ TEST(ReadCloud, MissingFileAndUnknownFormat) {
   test::TempDir dir;
   EXPECT_EQ(errorOf([&] { readCloud(dir.file("absent.pcd")); }), ErrorCode::FILE_NOT_FOUND);
   EXPECT_EQ(errorOf([&] { readCloud(dir.file(".")); }), ErrorCode::FILE_NOT_FOUND);
+  try {
+    readCloud(dir.file(""));
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
   const auto las = dir.write("cloud.las", "1 2 3\n");
   EXPECT_EQ(errorOf([&] { readCloud(las); }), ErrorCode::UNKNOWN_FORMAT);
 }
@@ -174,6 +179,68 @@ TEST(ReadCloud, MalformedPcdAndPlyAreParseErrors) {
                                 "VERSION 0.7\nFIELDS a b\nSIZE 4 4\nTYPE F F\nCOUNT 1 1\n"
                                 "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2\n");
   EXPECT_EQ(errorOf([&] { readCloud(no_xyz); }), ErrorCode::PARSE_ERROR);
+}
+
+TEST(ReadCloud, AHeaderPromisingMorePointsThanTheFileHoldsIsRefusedBeforeAnyAllocation) {
+  test::TempDir dir;
+  const std::string head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n";
+  const auto count = dir.write("count.pcd", head +
+                                                "COUNT 1000000000 1 1\nWIDTH 1\nHEIGHT 1\n"
+                                                "POINTS 1\nDATA binary\n0123456789ab");
+  const auto points = dir.write("points.pcd", head +
+                                                  "COUNT 1 1 1\nWIDTH 100000000\nHEIGHT 1\n"
+                                                  "POINTS 100000000\nDATA ascii\n1 2 3\n");
+  // binary_compressed: 16 compressed bytes that claim 0xFFFFFFF0 uncompressed.
+  std::string compressed = head +
+                           "COUNT 1 1 1\nWIDTH 357913940\nHEIGHT 1\nPOINTS 357913940\n"
+                           "DATA binary_compressed\n";
+  const std::uint32_t sizes[2] = {16, 0xFFFFFFF0u};
+  compressed.append(reinterpret_cast<const char*>(sizes), sizeof sizes);
+  compressed.append(16, '\0');
+  const auto lzf = dir.write("lzf.pcd", compressed);
+  const auto mismatch = dir.write("wxh.pcd", head +
+                                                 "COUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+                                                 "POINTS 3\nDATA ascii\n1 2 3\n");
+  for (const auto& path : {count, points, lzf, mismatch}) {
+    try {
+      readCloud(path);
+      ADD_FAILURE() << path;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR) << e.what();
+    }
+  }
+}
+
+TEST(ReadCloud, Float32SurveyCoordinatesAreRefusedWithTheReason) {
+  test::TempDir dir;
+  const auto path = dir.write("utm.pcd",
+                              "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                              "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+                              "612345 4423456 210\n612346 4423457 211\n");
+  try {
+    readCloud(path);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR);
+    EXPECT_NE(std::string(e.what()).find("float32"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("500.0 mm"), std::string::npos) << e.what();
+  }
+  // Near its origin a float32 cloud is fine.
+  const auto local = dir.write("local.pcd",
+                               "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                               "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1.5 2 3\n");
+  EXPECT_EQ(readCloud(local).cloud->size(), 1u);
+}
+
+TEST(ReadCloud, AStrayPointDoesNotMoveTheRecentringOffset) {
+  test::TempDir dir;
+  std::string text;
+  for (int i = 0; i < 50; ++i)
+    text += std::to_string(612345.0 + 0.01 * i) + " 5123456.5 250.25\n";
+  text += "1e7 1e7 1\n";
+  const auto r = readCloud(dir.write("stray.xyz", text));
+  EXPECT_NEAR(r.offset.x(), 612345.0, 1.0);
+  EXPECT_NEAR((*r.cloud)[49].x + r.offset.x(), 612345.49, 1e-4) << "millimetres kept";
 }
 
 TEST(ReadCloud, DoublePrecisionPcdFields) {

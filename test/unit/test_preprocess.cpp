@@ -126,6 +126,29 @@ TEST(VoxelDownsample, AGridTooFineForItsKeysIsAClearError) {
   }
 }
 
+TEST(Preprocess, AStrayPointFarFromTheTreeIsDroppedAndCountedNotFatal) {
+  Rng rng(5);
+  Points pts;
+  for (int i = 0; i < 5000; ++i)
+    pts.push_back(
+        Eigen::Vector3d(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(0.0, 3.0)));
+  const Points clean = pts;
+  pts.push_back(Eigen::Vector3d(1e7, 1e7, 1.0));
+  pts.push_back(Eigen::Vector3d(0.0, 0.0, -2e6));
+  pts.push_back(Eigen::Vector3d(30.0, 0.0, 1.0));  // a neighbour 30 m away is scene, not stray
+  Points kept = pts;
+  EXPECT_EQ(removeFarOutliers(kept), 2u);
+  EXPECT_EQ(kept.size(), clean.size() + 1);
+  ModelerConfig config;
+  config.ours_remove_clutter = false;
+  PreprocessStats stats;
+  const Points out = preprocess(pts, config, &stats);  // would not fit a grid's keys with them
+  EXPECT_EQ(stats.far_outliers, 2u);
+  EXPECT_EQ(out, preprocess(kept, config, nullptr));
+  Points tidy = clean;
+  EXPECT_EQ(removeFarOutliers(tidy), 0u) << "a cloud without strays keeps every point";
+}
+
 TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
   // A trunk, and a noisy 2 m wire beside it, not quite along x: the wire goes, its direction
   // is reported (the modeler takes short wire pieces as parallel to it), the trunk stays.

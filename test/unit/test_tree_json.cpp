@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/pose_json.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "temp_dir.h"
 
@@ -143,6 +144,28 @@ evaluation::GroundTruth sampleTruth() {
   minor.diameters = {0.005, 0.003};
   t.minor_branches.push_back(minor);
   return t;
+}
+
+TEST(PoseJson, RejectsAZeroOrScaledQuaternionAndNonFiniteNumbers) {
+  const auto pose = [](const std::string& text) {
+    return io::poseFromJson(nlohmann::json::parse(text), "guess_pose");
+  };
+  const std::string t = R"("translation": [1, 2, 3], )";
+  EXPECT_TRUE(
+      pose("{\"guess_pose\": {" + t + R"("rotation_xyzw": [0, 0, 0.7071068, 0.7071068]}})"));
+  EXPECT_FALSE(pose("{}"));
+  for (const char* bad : {"[0, 0, 0, 0]", "[0, 0, 0, 2]", "[0, 0, 0, 0.9]"}) {
+    try {
+      pose("{\"guess_pose\": {" + t + "\"rotation_xyzw\": " + bad + "}}");
+      ADD_FAILURE() << bad;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR);
+      EXPECT_NE(std::string(e.what()).find("unit quaternion"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(
+      pose(R"({"guess_pose": {"translation": [1e999, 0, 0], "rotation_xyzw": [0, 0, 0, 1]}})"),
+      std::exception);
 }
 
 TEST(TruthJson, RoundTripThroughAFile) {

@@ -9,6 +9,7 @@ namespace modeling {
 /// @brief What preprocessing removed, for the model's diagnostics.
 struct PreprocessStats {
   std::size_t input = 0;
+  std::size_t far_outliers = 0;  ///< stray points far outside the bulk of the cloud, dropped
   std::size_t after_voxel = 0;
   std::size_t floating = 0;  ///< isolated returns and mixed pixels (Eq. 1's targets)
   std::size_t ground = 0;
@@ -18,6 +19,12 @@ struct PreprocessStats {
 };
 
 class PointIndex;
+
+/// @brief Drops the points far outside the cloud's bulk (a stray return at 10 km is bad data,
+/// and it would size every grid of the modeler): beyond FAR_OUTLIER_MARGIN times the extent of
+/// the 1st to 99th percentile box, and at least FAR_OUTLIER_MIN_MARGIN_M, on any axis.
+/// @returns how many were dropped
+std::size_t removeFarOutliers(Points& pts);
 
 /// @brief Median distance from a point to its nearest neighbour (on a sample of the points;
 /// neighbours chosen in single precision, as PointIndex does).
