@@ -16,25 +16,42 @@ namespace simulation {
 
 namespace {
 
+// A preview frames a tree: a model wider or taller than this is not one.
+constexpr double MAX_PREVIEW_SPAN_M = 100.0;
+// The picture is at most this many times as tall as wide.
+constexpr int MAX_ASPECT = 4;
+// Longest line drawn, pixels (a few canvas diagonals).
+constexpr double MAX_LINE_PIXELS = 1e5;
+
 struct Canvas {
   int w, h;
   std::vector<std::uint8_t> rgb;
   Canvas(int width, int height)
       : w(width), h(height), rgb(static_cast<std::size_t>(width) * height * 3, 255) {}
-  void put(int x, int y, const std::uint8_t c[3]) {
-    if (x < 0 || y < 0 || x >= w || y >= h)
+  bool inside(double x, double y, double margin = 0.0) const {
+    return x >= -margin && y >= -margin && x < w + margin && y < h + margin;
+  }
+  // Takes doubles: a pixel coordinate far outside the canvas must not be cast to int.
+  void put(double x, double y, const std::uint8_t c[3]) {
+    if (!inside(x, y))
       return;
-    std::copy(c, c + 3, &rgb[(static_cast<std::size_t>(y) * w + x) * 3]);
+    const auto xi = static_cast<std::size_t>(x), yi = static_cast<std::size_t>(y);
+    std::copy(c, c + 3, &rgb[(yi * w + xi) * 3]);
   }
   void disc(double cx, double cy, double r, const std::uint8_t c[3]) {
+    if (!inside(cx, cy, r + 1.0))
+      return;
     const int ri = static_cast<int>(std::ceil(r));
     for (int dy = -ri; dy <= ri; ++dy)
       for (int dx = -ri; dx <= ri; ++dx)
         if (dx * dx + dy * dy <= r * r + 0.5)
-          put(static_cast<int>(cx) + dx, static_cast<int>(cy) + dy, c);
+          put(std::floor(cx) + dx, std::floor(cy) + dy, c);
   }
   void line(double x0, double y0, double x1, double y1, double r, const std::uint8_t c[3]) {
-    const int steps = static_cast<int>(std::ceil(std::hypot(x1 - x0, y1 - y0))) + 1;
+    const double length = std::hypot(x1 - x0, y1 - y0);
+    if (!std::isfinite(length) || length > MAX_LINE_PIXELS)
+      return;  // a segment no tree has; the canvas is sized to the model, not to it
+    const int steps = static_cast<int>(std::ceil(length)) + 1;
     for (int i = 0; i <= steps; ++i) {
       const double t = static_cast<double>(i) / steps;
       disc(x0 + t * (x1 - x0), y0 + t * (y1 - y0), r, c);
@@ -57,15 +74,21 @@ struct FrontView {
     lo = box_lo - Eigen::Vector2d(0.3, 0.1);
     hi = box_hi + Eigen::Vector2d(0.3, 0.2);
     lo.y() = std::min(lo.y(), 0.0);
-    scale = width / (hi.x() - lo.x());
-    height = std::max(1, static_cast<int>((hi.y() - lo.y()) * scale));
+    const Eigen::Vector2d span = hi - lo;
+    if (!span.allFinite() || span.maxCoeff() > MAX_PREVIEW_SPAN_M) {
+      throw Error(ErrorCode::INVALID_ARGUMENT, "the model spans " + std::to_string(span.x()) +
+                                                   " m x " + std::to_string(span.y()) +
+                                                   " m, not a tree: nothing rendered");
+    }
+    scale = width / span.x();
+    height = std::clamp(static_cast<int>(span.y() * scale), 1, MAX_ASPECT * width);
     canvas = Canvas(width, height);
     // Points: darker when nearer the viewer (smaller y), so depth reads at a glance.
     for (const auto& p : cloud.points) {
       const double shade = std::clamp(60.0 + 40.0 * (p.y + 1.5), 40.0, 200.0);
       const std::uint8_t c[3] = {static_cast<std::uint8_t>(shade), static_cast<std::uint8_t>(shade),
                                  static_cast<std::uint8_t>(shade)};
-      canvas.put(static_cast<int>(px(p.x)), static_cast<int>(py(p.z)), c);
+      canvas.put(px(p.x), py(p.z), c);
     }
   }
   double px(double x) const { return (x - lo.x()) * scale; }

@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
       "Usage: render_model CLOUD MODEL --output PNG [--width PIXELS]\n"
       "Draws the model's cylinders (trunk brown, primary branches green, pruning candidates "
       "red) over the cloud, seen from -y (x right, z up); cloud and model in one frame.\n"
-      "Exit status: 0 written, 2 usage, 3 unreadable input, 7 cannot write");
+      "Exit status: 0 written, 2 usage, 3 unreadable input or a model that is not a tree, 7 "
+      "cannot write");
   desc.add_options()("help,h", "this help")("cloud", po::value(&cloud_path)->required(),
                                             "PCD, PLY or x y z text")(
       "model", po::value(&model_path)->required(), "model.json")(
@@ -47,7 +48,12 @@ int main(int argc, char** argv) {
       shift.translation() = -cloud.offset;
       model = modeling::transformModel(model, shift);
     }
-    simulation::renderModelPreview(*cloud.cloud, model, output, width);
+    try {
+      simulation::renderModelPreview(*cloud.cloud, model, output, width);
+    } catch (const Error& e) {
+      std::cerr << "render_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
+      return e.code() == ErrorCode::IO_FAILURE ? 7 : 3;
+    }
     return 0;
   } catch (const po::error& e) {
     std::cerr << "render_model: " << e.what() << "\n" << desc << "\n";

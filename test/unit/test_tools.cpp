@@ -132,6 +132,32 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
   EXPECT_NE(branch.find(",0.400,0"), std::string::npos) << branch;
 }
 
+TEST(RenderModelTool, FarPointsAreSkippedAndAModelThatIsNoTreeIsRefused) {
+  test::TempDir dir;
+  // A 2 m trunk, and a cloud with points near +-1e30 beside the tree's.
+  std::string cloud = "0 0 0.5\n0.05 0 1\n";
+  for (int i = 0; i < 50; ++i)
+    cloud += (i % 2 ? "1e30 " : "-1e30 ") + std::to_string(i) + " 1e30\n";
+  const auto cloud_path = dir.write("far.xyz", cloud);
+  modeling::TreeModel m;
+  modeling::CylinderModel t;
+  t.center = Eigen::Vector3d(0, 0, 1);
+  t.length = 2.0;
+  t.diameter = 0.1;
+  m.trunk.push_back(t);
+  const auto model_path = dir.write("model.json", io::modelToJson(m));
+  std::string out;
+  ASSERT_EQ(run("render_model", cloud_path + " " + model_path + " -o " + dir.file("a.png"), &out),
+            0)
+      << out;
+  EXPECT_LT(std::filesystem::file_size(dir.file("a.png")), 1000000u);
+  m.trunk[0].center = Eigen::Vector3d(1e30, 0, 1e30);
+  const auto far_model = dir.write("far.json", io::modelToJson(m));
+  EXPECT_EQ(run("render_model", cloud_path + " " + far_model + " -o " + dir.file("b.png"), &out),
+            3);
+  EXPECT_NE(out.find("not a tree"), std::string::npos) << out;
+}
+
 TEST(Lms111DecodeTool, DecodesTheRealTelegramAndRejectsOthers) {
   test::TempDir dir;
   std::string out;
