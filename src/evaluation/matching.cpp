@@ -1,5 +1,7 @@
 #include "dormant_tree_modeling/evaluation/matching.h"
 
+#include "dormant_tree_modeling/common/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -44,34 +46,28 @@ bool canMatch(const modeling::CylinderModel& detection, const Polyline& line,
          q.arc_length <= bounds.max_arc_length && angle <= bounds.max_angle_deg * M_PI / 180.0;
 }
 
-std::vector<int> assign(const std::vector<std::vector<double>>& cost, double forbidden) {
-  const int rows = static_cast<int>(cost.size());
-  const int cols = rows > 0 ? static_cast<int>(cost[0].size()) : 0;
-  std::vector<int> result(rows, -1);
-  if (rows == 0 || cols == 0)
-    return result;
-  // Square the problem (Kuhn-Munkres with potentials, O(n^3)); padding costs `forbidden`.
-  const int n = std::max(rows, cols);
-  auto c = [&](int i, int j) {
-    return i < rows && j < cols ? std::min(cost[i][j], forbidden) : forbidden;
-  };
+namespace {
+
+// Kuhn-Munkres with potentials on an n x m matrix with n <= m: every row gets a distinct
+// column, the total cost least. O(n^2 m), so the smaller side must be the rows.
+std::vector<int> assignRows(const std::vector<std::vector<double>>& c, int n, int m) {
   const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> u(n + 1, 0.0), v(n + 1, 0.0);
-  std::vector<int> p(n + 1, 0), way(n + 1, 0);
+  std::vector<double> u(n + 1, 0.0), v(m + 1, 0.0);
+  std::vector<int> p(m + 1, 0), way(m + 1, 0);
   for (int i = 1; i <= n; ++i) {
     p[0] = i;
     int j0 = 0;
-    std::vector<double> minv(n + 1, inf);
-    std::vector<char> used(n + 1, 0);
+    std::vector<double> minv(m + 1, inf);
+    std::vector<char> used(m + 1, 0);
     do {
       used[j0] = 1;
       const int i0 = p[j0];
       double delta = inf;
       int j1 = 0;
-      for (int j = 1; j <= n; ++j) {
+      for (int j = 1; j <= m; ++j) {
         if (used[j])
           continue;
-        const double cur = c(i0 - 1, j - 1) - u[i0] - v[j];
+        const double cur = c[i0 - 1][j - 1] - u[i0] - v[j];
         if (cur < minv[j]) {
           minv[j] = cur;
           way[j] = j0;
@@ -81,7 +77,7 @@ std::vector<int> assign(const std::vector<std::vector<double>>& cost, double for
           j1 = j;
         }
       }
-      for (int j = 0; j <= n; ++j) {
+      for (int j = 0; j <= m; ++j) {
         if (used[j]) {
           u[p[j]] += delta;
           v[j] -= delta;
@@ -97,13 +93,66 @@ std::vector<int> assign(const std::vector<std::vector<double>>& cost, double for
       j0 = j1;
     } while (j0 != 0);
   }
-  for (int j = 1; j <= n; ++j) {
-    const int i = p[j] - 1, col = j - 1;
-    if (i < rows && col < cols && cost[i][col] < forbidden)
-      result[i] = col;
+  std::vector<int> row_to_col(n, -1);
+  for (int j = 1; j <= m; ++j) {
+    if (p[j] > 0)
+      row_to_col[p[j] - 1] = j - 1;
+  }
+  return row_to_col;
+}
+
+}  // namespace
+
+// Rows and columns without any allowed pair cannot be matched and are left out, and the
+// smaller side becomes the rows: a model with thousands of detections against a tree's dozens
+// of branches costs O(branches^2 x detections), not O(detections^3).
+std::vector<int> assign(const std::vector<std::vector<double>>& cost, double forbidden) {
+  const int rows = static_cast<int>(cost.size());
+  const int cols = rows > 0 ? static_cast<int>(cost[0].size()) : 0;
+  std::vector<int> result(rows, -1);
+  std::vector<int> live_rows, live_cols;
+  std::vector<char> col_live(cols, 0);
+  for (int i = 0; i < rows; ++i) {
+    bool any = false;
+    for (int j = 0; j < cols; ++j) {
+      if (cost[i][j] < forbidden) {
+        any = true;
+        col_live[j] = 1;
+      }
+    }
+    if (any)
+      live_rows.push_back(i);
+  }
+  for (int j = 0; j < cols; ++j) {
+    if (col_live[j])
+      live_cols.push_back(j);
+  }
+  if (live_rows.empty())
+    return result;
+  const bool transposed = live_rows.size() > live_cols.size();
+  const std::vector<int>& a = transposed ? live_cols : live_rows;
+  const std::vector<int>& b = transposed ? live_rows : live_cols;
+  std::vector<std::vector<double>> c(a.size(), std::vector<double>(b.size()));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < b.size(); ++j) {
+      const double v = transposed ? cost[b[j]][a[i]] : cost[a[i]][b[j]];
+      c[i][j] = std::min(v, forbidden);
+    }
+  }
+  const auto matched = assignRows(c, static_cast<int>(a.size()), static_cast<int>(b.size()));
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (matched[i] < 0)
+      continue;
+    const int r = transposed ? b[matched[i]] : a[i];
+    const int col = transposed ? a[i] : b[matched[i]];
+    if (cost[r][col] < forbidden)
+      result[r] = col;
   }
   return result;
 }
+
+// More primary branches than any tree has (a model of noise): refused rather than scored.
+constexpr std::size_t MAX_DETECTIONS = 100000;
 
 TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
                    const MatchBounds& bounds) {
@@ -111,6 +160,12 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
   TreeScore s;
   s.pb = static_cast<int>(truth.primary_branches.size());
   s.runtime_s = model.runtime_s;
+  if (model.primary_branches.size() > MAX_DETECTIONS) {
+    throw Error(ErrorCode::INVALID_ARGUMENT, "the model has " +
+                                                 std::to_string(model.primary_branches.size()) +
+                                                 " primary branches; no tree has more than " +
+                                                 std::to_string(MAX_DETECTIONS) + ": not scored");
+  }
   const int detections = static_cast<int>(model.primary_branches.size());
   std::vector<std::vector<double>> cost(detections, std::vector<double>(s.pb, FORBIDDEN));
   std::vector<char> any_primary(detections, 0);

@@ -1,0 +1,102 @@
+// The scoring's one-to-one assignment against brute force, and its cost with thousands of
+// detections.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <functional>
+#include <numeric>
+
+#include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/evaluation/matching.h"
+
+namespace dormant_tree_modeling {
+namespace evaluation {
+namespace {
+
+constexpr double FORBIDDEN = 1e9;
+
+// (matches, total cost) of an assignment, matches first: what the scoring optimises.
+std::pair<int, double> value(const std::vector<std::vector<double>>& cost,
+                             const std::vector<int>& a) {
+  int n = 0;
+  double total = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] >= 0) {
+      ++n;
+      total += cost[i][a[i]];
+    }
+  }
+  return {n, total};
+}
+
+// Every injective partial assignment of rows to columns, the best by (matches, -cost).
+std::pair<int, double> bruteForce(const std::vector<std::vector<double>>& cost) {
+  const int rows = static_cast<int>(cost.size()), cols = static_cast<int>(cost[0].size());
+  std::pair<int, double> best{0, 0.0};
+  std::vector<int> a(rows, -1);
+  std::vector<char> taken(cols, 0);
+  std::function<void(int)> walk = [&](int i) {
+    if (i == rows) {
+      const auto v = value(cost, a);
+      if (v.first > best.first || (v.first == best.first && v.second < best.second - 1e-12))
+        best = v;
+      return;
+    }
+    a[i] = -1;
+    walk(i + 1);
+    for (int j = 0; j < cols; ++j) {
+      if (taken[j] || cost[i][j] >= FORBIDDEN)
+        continue;
+      taken[j] = 1;
+      a[i] = j;
+      walk(i + 1);
+      taken[j] = 0;
+      a[i] = -1;
+    }
+  };
+  walk(0);
+  return best;
+}
+
+TEST(Assign, FindsTheMostMatchesAtTheLeastCostLikeBruteForce) {
+  Rng rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int rows = 1 + trial % 6, cols = 1 + (trial / 6) % 6;
+    std::vector<std::vector<double>> cost(rows, std::vector<double>(cols));
+    for (auto& row : cost) {
+      for (auto& c : row)
+        c = rng.uniform() < 0.4 ? FORBIDDEN : std::round(rng.uniform(0.0, 10.0) * 8.0) / 8.0;
+    }
+    const auto a = assign(cost, FORBIDDEN);
+    ASSERT_EQ(a.size(), cost.size());
+    std::vector<int> used;
+    for (const int j : a) {
+      if (j >= 0)
+        used.push_back(j);
+    }
+    std::sort(used.begin(), used.end());
+    EXPECT_TRUE(std::adjacent_find(used.begin(), used.end()) == used.end()) << "one-to-one";
+    const auto got = value(cost, a), best = bruteForce(cost);
+    EXPECT_EQ(got.first, best.first) << "trial " << trial;
+    EXPECT_NEAR(got.second, best.second, 1e-9) << "trial " << trial;
+  }
+}
+
+TEST(Assign, ThousandsOfDetectionsAgainstDozensOfBranchesIsQuick) {
+  // 5000 detections x 40 branches (O(n^3) on the padded square took minutes); each branch
+  // has its own nearest detection at cost 0.
+  const int detections = 5000, branches = 40;
+  std::vector<std::vector<double>> cost(detections, std::vector<double>(branches, FORBIDDEN));
+  for (int d = 0; d < detections; ++d) {
+    const int t = d % branches;
+    cost[d][t] = d < branches ? 0.0 : 1.0 + d * 1e-3;
+  }
+  const auto a = assign(cost, FORBIDDEN);
+  for (int t = 0; t < branches; ++t)
+    EXPECT_EQ(a[t], t);
+  EXPECT_EQ(std::count(a.begin(), a.end(), -1), detections - branches);
+}
+
+}  // namespace
+}  // namespace evaluation
+}  // namespace dormant_tree_modeling
