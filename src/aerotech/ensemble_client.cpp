@@ -1,5 +1,6 @@
 #include "dormant_tree_modeling/aerotech/ensemble_client.h"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -12,6 +13,8 @@ namespace {
 
 // The plane the ASCII interface's motion commands run in.
 constexpr int MOTION_PLANE = 0;
+// Longest wait between two looks at the interrupt flag, s.
+constexpr double INTERRUPT_POLL_S = 0.05;
 
 double steadySeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -39,9 +42,10 @@ bool EnsembleClient::connected() const {
   return connection_.isOpen();
 }
 
+// Lock-free: diagnostics ask while another thread waits on a silent controller.
 std::uint64_t EnsembleClient::reconnects() const {
-  std::lock_guard<std::recursive_mutex> lock(mutex_);
-  return connects_ > 0 ? connects_ - 1 : 0;
+  const std::uint64_t n = connects_;
+  return n > 0 ? n - 1 : 0;
 }
 
 void EnsembleClient::close() {
@@ -49,13 +53,29 @@ void EnsembleClient::close() {
   connection_.close();
 }
 
-void EnsembleClient::ensureConnected() {
+void EnsembleClient::interrupt() {
+  interrupted_ = true;
+}
+
+void EnsembleClient::resume() {
+  interrupted_ = false;
+}
+
+void EnsembleClient::throwIfInterrupted(const std::string& line) {
+  if (!interrupted_)
+    return;
+  connection_.close();  // a reply still on its way would be out of step
+  throw Error(ErrorCode::IO_FAILURE, "'" + line + "' interrupted: the client is stopping");
+}
+
+void EnsembleClient::ensureConnected(double timeout_s) {
   if (connection_.isOpen())
     return;
+  throwIfInterrupted("connect");
   framer_.clear();
-  connection_.connect(config_.host, config_.port, config_.connect_timeout_s);
+  connection_.connect(config_.host, config_.port, std::min(timeout_s, config_.connect_timeout_s));
   ++connects_;
-  const Reply r = exchange(command::waitModeNoWait(), config_.reply_timeout_s);
+  const Reply r = exchange(command::waitModeNoWait(), std::min(timeout_s, config_.reply_timeout_s));
   if (!r.ok()) {
     connection_.close();
     throw Error(ErrorCode::IO_FAILURE, std::string("the controller refused WAIT MODE NOWAIT: ") +
@@ -75,6 +95,7 @@ Reply EnsembleClient::exchange(const std::string& line, double timeout_s) {
         throw Error(ErrorCode::IO_FAILURE, "reply to '" + line + "': " + e.what());
       }
     }
+    throwIfInterrupted(line);
     const double left = deadline - steadySeconds();
     if (left <= 0) {
       // A late reply would be taken for the next command's: drop the connection instead.
@@ -82,7 +103,7 @@ Reply EnsembleClient::exchange(const std::string& line, double timeout_s) {
       throw Error(ErrorCode::IO_FAILURE,
                   "no reply to '" + line + "' within " + std::to_string(timeout_s) + " s");
     }
-    const std::string bytes = connection_.receiveSome(left);
+    const std::string bytes = connection_.receiveSome(std::min(left, INTERRUPT_POLL_S));
     framer_.feed(bytes);
   }
 }
@@ -90,14 +111,14 @@ Reply EnsembleClient::exchange(const std::string& line, double timeout_s) {
 Reply EnsembleClient::send(const std::string& line, double timeout_s, bool idempotent) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   try {
-    ensureConnected();
+    ensureConnected(timeout_s);
     return exchange(line, timeout_s);
   } catch (const Error& e) {
     connection_.close();
-    if (!idempotent)
+    if (!idempotent || interrupted_)
       throw;
   }
-  ensureConnected();
+  ensureConnected(timeout_s);
   return exchange(line, timeout_s);
 }
 
@@ -137,8 +158,8 @@ void EnsembleClient::moveIncremental(const std::string& axis, double distance, d
 void EnsembleClient::freerun(const std::string& axis, double velocity) {
   checked(command::freerun(axis, velocity), axis, config_.reply_timeout_s, false);
 }
-void EnsembleClient::abort(const std::string& axis) {
-  checked(command::abort(axis), axis, config_.reply_timeout_s, true);
+void EnsembleClient::abort(const std::string& axis, double timeout_s) {
+  checked(command::abort(axis), axis, timeout_s > 0 ? timeout_s : config_.reply_timeout_s, true);
 }
 void EnsembleClient::faultAck(const std::string& axis) {
   checked(command::faultAck(axis), axis, config_.reply_timeout_s, true);
@@ -181,6 +202,7 @@ void EnsembleClient::waitForMove(const std::string& axis, double timeout_s, doub
       return;
     if (!s.enabled())
       throw Error(ErrorCode::IO_FAILURE, "axis " + axis + " was disabled during the move");
+    throwIfInterrupted("waiting for axis " + axis);
     if (steadySeconds() > deadline) {
       throw Error(ErrorCode::IO_FAILURE, "axis " + axis + " not in position within " +
                                              std::to_string(timeout_s) + " s (" + s.describe() +

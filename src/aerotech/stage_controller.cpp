@@ -1,5 +1,6 @@
 #include "dormant_tree_modeling/aerotech/stage_controller.h"
 
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -109,10 +110,22 @@ StageHealth StageController::health() {
   return h;
 }
 
-void StageController::stopAll() {
+void StageController::interrupt() {
+  command_.interrupt();
+  feedback_.interrupt();
+}
+
+void StageController::stopAll(double deadline_s) {
+  command_.resume();
+  const auto start = std::chrono::steady_clock::now();
   for (const StageAxisConfig* a : {&config_.rotary, &config_.slide}) {
+    const double left =
+        deadline_s -
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (left <= 0)
+      break;
     try {
-      command_.abort(a->axis);
+      command_.abort(a->axis, left / 2);  // both axes within the deadline
     } catch (const Error&) {
     }
   }

@@ -13,7 +13,11 @@ namespace ros_layer {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-constexpr double SETUP_RETRY_S = 2.0;
+// Shutdown: the axes' aborts get this long in all (the node stops within 2 s; a controller
+// that answers at all answers an ABORT in milliseconds).
+constexpr double STOP_DEADLINE_S = 0.6;
+// Longest sleep between two looks at the stop flag, s.
+constexpr double STOP_POLL_S = 0.05;
 constexpr double HEALTH_PERIOD_S = 1.0;
 
 Eigen::Vector3d vectorParam(ros::NodeHandle& pnh, const std::string& name) {
@@ -79,6 +83,12 @@ StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& p
   carriage_frame_ = pnh.param<std::string>("slide_carriage_frame", "slide_carriage");
   stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
   laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
+  reconnect_min_s_ = pnh.param("reconnect_min", reconnect_min_s_);
+  reconnect_max_s_ = pnh.param("reconnect_max", reconnect_max_s_);
+  if (!(reconnect_min_s_ > 0 && reconnect_max_s_ >= reconnect_min_s_)) {
+    throw Error(ErrorCode::INVALID_ARGUMENT,
+                "stage_controller: need 0 < ~reconnect_min <= ~reconnect_max (s)");
+  }
   joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 50);
   move_srv_ = pnh.advertiseService("move_axis", &StageControllerNode::moveAxis, this);
   home_srv_ = pnh.advertiseService("home", &StageControllerNode::home, this);
@@ -94,14 +104,58 @@ StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& p
 
 StageControllerNode::~StageControllerNode() {
   stop_ = true;
+  stage_->interrupt();  // the threads' calls on a silent controller return at once
   if (setup_thread_.joinable())
     setup_thread_.join();
   if (feedback_thread_.joinable())
     feedback_thread_.join();
-  stage_->stopAll();
+  stage_->stopAll(STOP_DEADLINE_S);
+}
+
+bool StageControllerNode::sleepUnlessStopped(double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (!stop_) {
+    const double left = (end - ros::WallTime::now()).toSec();
+    if (left <= 0)
+      return true;
+    ros::WallDuration(std::min(left, STOP_POLL_S)).sleep();
+  }
+  return false;
+}
+
+void StageControllerNode::noteReconnects() {
+  const std::uint64_t now = stage_->reconnects();
+  const std::uint64_t before = reconnects_seen_.exchange(now);
+  if (now > before) {
+    ROS_WARN(
+        "stage: the connection to the controller at %s:%d dropped and was opened again "
+        "(%llu times in all)",
+        stage_->config().controller.host.c_str(), stage_->config().controller.port,
+        static_cast<unsigned long long>(now));
+  }
+}
+
+double StageControllerNode::failed(const Error& e, const char* what, double& backoff) {
+  {
+    std::lock_guard<std::mutex> lock(status_mutex_);
+    last_error_ = e.what();
+    health_known_ = false;
+  }
+  const double wait = backoff;
+  // The first failure of a streak is logged; while it lasts, once a minute (the diagnostics
+  // carry the last error meanwhile).
+  if (backoff == reconnect_min_s_) {
+    ROS_ERROR("stage %s failed: %s; retrying in %.1f s, doubling up to %.1f s", what, e.what(),
+              wait, reconnect_max_s_);
+  } else {
+    ROS_ERROR_THROTTLE(60.0, "stage %s still failing: %s", what, e.what());
+  }
+  backoff = std::min(reconnect_max_s_, backoff * 2.0);
+  return wait;
 }
 
 void StageControllerNode::setUpLoop() {
+  double backoff = reconnect_min_s_;
   while (!stop_ && !ready_) {
     try {
       stage_->setUp();
@@ -110,14 +164,9 @@ void StageControllerNode::setUpLoop() {
                stage_->config().slide.axis.c_str(),
                stage_->config().home_on_start ? " and homed" : "");
     } catch (const Error& e) {
-      {
-        std::lock_guard<std::mutex> lock(status_mutex_);
-        last_error_ = e.what();
-      }
-      ROS_ERROR_THROTTLE(10.0, "stage set-up failed: %s; retrying every %.0f s", e.what(),
-                         SETUP_RETRY_S);
-      for (int i = 0; i < 20 && !stop_; ++i)
-        ros::WallDuration(SETUP_RETRY_S / 20).sleep();
+      if (stop_)
+        break;
+      sleepUnlessStopped(failed(e, "set-up", backoff));
     }
   }
 }
@@ -127,6 +176,7 @@ void StageControllerNode::feedbackLoop() {
   ros::WallRate rate(c.joint_state_rate);
   ros::WallTime last_health(0.0), window_start = ros::WallTime::now();
   int samples = 0;
+  double backoff = reconnect_min_s_;
   while (!stop_ && ros::ok()) {
     try {
       const ros::Time before = ros::Time::now();
@@ -162,14 +212,13 @@ void StageControllerNode::feedbackLoop() {
         window_start = now;
         last_health = now;
       }
+      backoff = reconnect_min_s_;
+      noteReconnects();
     } catch (const Error& e) {
-      {
-        std::lock_guard<std::mutex> lock(status_mutex_);
-        last_error_ = e.what();
-        health_known_ = false;
-      }
-      ROS_WARN_THROTTLE(5.0, "stage feedback: %s", e.what());
-      ros::WallDuration(0.2).sleep();
+      if (stop_)
+        break;
+      sleepUnlessStopped(failed(e, "feedback", backoff));
+      continue;
     }
     rate.sleep();
   }
@@ -199,6 +248,7 @@ bool StageControllerNode::moveAxis(dormant_tree_modeling::MoveAxis::Request& req
   q.relative = req.relative;
   q.wait = req.wait;
   const aerotech::MoveResult r = stage_->move(q);
+  noteReconnects();
   res.success = r.success;
   res.message = r.message;
   res.position = r.position;

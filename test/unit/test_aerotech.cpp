@@ -2,13 +2,17 @@
 // and the client against the emulator on 127.0.0.1 (faults, dropped and idle sockets).
 #include <gtest/gtest.h>
 
+#include <boost/asio.hpp>
 #include <chrono>
 #include <cmath>
+#include <future>
+#include <list>
 #include <thread>
 
 #include "dormant_tree_modeling/aerotech/ascii_protocol.h"
 #include "dormant_tree_modeling/aerotech/ensemble_client.h"
 #include "dormant_tree_modeling/aerotech/ensemble_server.h"
+#include "dormant_tree_modeling/aerotech/stage_controller.h"
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
@@ -193,6 +197,79 @@ TEST(EnsembleClient, ReconnectsAfterDroppedAndIdleSocketsAndReportsInvalidComman
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("invalid command"), std::string::npos) << e.what();
   }
+}
+
+// A controller that accepts connections and never answers.
+class SilentController {
+ public:
+  SilentController() : acceptor_(io_, {boost::asio::ip::make_address("127.0.0.1"), 0}) {
+    accept();
+    thread_ = std::thread([this] { io_.run(); });
+  }
+  ~SilentController() {
+    io_.stop();
+    thread_.join();
+  }
+  int port() const { return acceptor_.local_endpoint().port(); }
+
+ private:
+  void accept() {
+    acceptor_.async_accept([this](boost::system::error_code ec, boost::asio::ip::tcp::socket s) {
+      if (!ec)
+        held_.push_back(std::move(s));  // kept open, never read, never answered
+      accept();
+    });
+  }
+  boost::asio::io_context io_;
+  boost::asio::ip::tcp::acceptor acceptor_;
+  std::list<boost::asio::ip::tcp::socket> held_;
+  std::thread thread_;
+};
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+TEST(EnsembleClient, AnInterruptEndsAWaitOnASilentControllerAtOnce) {
+  SilentController silent;
+  EnsembleClientConfig c;
+  c.host = "127.0.0.1";
+  c.port = silent.port();
+  c.reply_timeout_s = 5.0;
+  EnsembleClient client(c);
+  auto call = std::async(std::launch::async, [&] { client.position("X"); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto start = std::chrono::steady_clock::now();
+  client.interrupt();
+  try {
+    call.get();
+    FAIL() << "no reply, yet no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("interrupted"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(secondsSince(start), 0.5) << "not retried on a fresh connection either";
+  EXPECT_THROW(client.position("X"), Error) << "interrupted until resumed";
+}
+
+TEST(StageController, StopsWithinItsDeadlineWhenTheControllerNeverAnswers) {
+  SilentController silent;
+  StageConfig config;
+  config.controller.host = "127.0.0.1";
+  config.controller.port = silent.port();
+  config.controller.reply_timeout_s = 5.0;
+  StageController stage(config);
+  auto feedback = std::async(std::launch::async, [&] {
+    try {
+      stage.feedback();
+    } catch (const Error&) {
+    }
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto start = std::chrono::steady_clock::now();
+  stage.interrupt();
+  feedback.get();
+  stage.stopAll(1.0);
+  EXPECT_LT(secondsSince(start), 1.5);  // was 11-13 s: every abort waited its reply timeout
 }
 
 TEST(EnsembleClient, NoControllerIsAClearError) {

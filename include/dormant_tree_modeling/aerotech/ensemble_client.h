@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <string>
@@ -39,7 +40,8 @@ class EnsembleClient {
   void moveAbsolute(const std::string& axis, double position, double velocity);
   void moveIncremental(const std::string& axis, double distance, double velocity);
   void freerun(const std::string& axis, double velocity);
-  void abort(const std::string& axis);
+  /// @param timeout_s reply timeout, connection included; <= 0: reply_timeout_s
+  void abort(const std::string& axis, double timeout_s = -1.0);
   void faultAck(const std::string& axis);
   void acknowledgeAll();
   double position(const std::string& axis);
@@ -59,6 +61,11 @@ class EnsembleClient {
   /// @throws Error IO_FAILURE on transport failure or timeout
   Reply send(const std::string& line, double timeout_s, bool idempotent);
 
+  /// @brief Make every blocking call return within INTERRUPT_POLL_S with an IO_FAILURE
+  /// "interrupted", until resume(). Safe from any thread; for shutting down promptly.
+  void interrupt();
+  void resume();
+
   bool connected() const;
   std::uint64_t reconnects() const;
   const EnsembleClientConfig& config() const { return config_; }
@@ -66,7 +73,8 @@ class EnsembleClient {
 
  private:
   Reply exchange(const std::string& line, double timeout_s);
-  void ensureConnected();
+  void ensureConnected(double timeout_s);
+  void throwIfInterrupted(const std::string& line);
   /// Runs a command and throws the decoded reason on anything but success.
   Reply checked(const std::string& line, const std::string& axis, double timeout_s,
                 bool idempotent);
@@ -74,7 +82,8 @@ class EnsembleClient {
   EnsembleClientConfig config_;
   TcpConnection connection_;
   LineFramer framer_;
-  std::uint64_t connects_ = 0;
+  std::atomic<std::uint64_t> connects_{0};
+  std::atomic<bool> interrupted_{false};
   mutable std::recursive_mutex mutex_;
 };
 

@@ -57,8 +57,12 @@ class StageController {
   StageFeedback feedback();
   /// @brief Status and fault words of both axes. @throws Error IO_FAILURE
   StageHealth health();
-  /// @brief Abort both axes (best effort; shutdown).
-  void stopAll();
+  /// @brief Make the blocking calls of other threads (set-up, feedback, a move being waited
+  /// for) return at once with an error: the first step of shutting down.
+  void interrupt();
+  /// @brief Abort both axes, best effort, within `deadline_s` (shutdown; a controller that
+  /// does not answer must not hold the node up).
+  void stopAll(double deadline_s = 1.0);
   /// @brief The axis configuration named by controller axis or joint name, or null.
   const StageAxisConfig* axis(const std::string& name) const;
   const StageConfig& config() const { return config_; }

@@ -13,6 +13,7 @@
 
 #include "dormant_tree_modeling/MoveAxis.h"
 #include "dormant_tree_modeling/aerotech/stage_controller.h"
+#include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -41,6 +42,13 @@ class StageControllerNode {
   bool home(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void setUpLoop();
   void feedbackLoop();
+  /// Sleeps, or returns false at once when the node stops meanwhile.
+  bool sleepUnlessStopped(double seconds);
+  /// Logs a connection the controller dropped (once per drop).
+  void noteReconnects();
+  /// Records a failed set-up or feedback round, logs the first of a streak, and returns the
+  /// back-off to wait before the next one (doubling up to reconnect_max_s_).
+  double failed(const Error& e, const char* what, double& backoff);
   void publishStaticFrames();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
@@ -60,6 +68,9 @@ class StageControllerNode {
   bool health_known_ = false;
   double feedback_rate_ = 0;  // measured, Hz
   std::thread setup_thread_, feedback_thread_;
+  double reconnect_min_s_ = 0.2;  // first back-off after a failure, doubling per failure
+  double reconnect_max_s_ = 5.0;
+  std::atomic<std::uint64_t> reconnects_seen_{0};
 };
 
 }  // namespace ros_layer
