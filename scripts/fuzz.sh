@@ -12,7 +12,7 @@ cp -n "$root"/fuzz/corpus/* "$out/corpus/" 2>/dev/null || true
 # The code that reads the device's bytes, compiled into the fuzzer with the sanitizers.
 sources=(cola cola_fields scan_telegram laser_scan device_emulator scan_source capture requests
   session_replay)
-files=("$root/fuzz/lms111_fuzz.cpp" "$root/src/common/error.cpp")
+files=("$root/fuzz/lms111_fuzz.cpp" "$root/src/common/error.cpp" "$root/src/common/printable.cpp")
 for s in "${sources[@]}"; do files+=("$root/src/lms111/$s.cpp"); done
 echo "fuzz: building lms111_fuzz"
 clang++ -std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \

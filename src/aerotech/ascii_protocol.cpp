@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/printable.h"
 
 namespace dormant_tree_modeling {
 namespace aerotech {
@@ -40,7 +41,8 @@ double Reply::number() const {
   char* end = nullptr;
   const double v = std::strtod(begin, &end);
   if (value.empty() || end != begin + value.size())
-    throw Error(ErrorCode::PARSE_ERROR, "reply value '" + value + "' is not a number");
+    throw Error(ErrorCode::PARSE_ERROR,
+                "reply value '" + printableBytes(value, 40) + "' is not a number");
   return v;
 }
 
@@ -56,7 +58,8 @@ Reply parseReply(const std::string& line) {
       r.status = static_cast<ReplyStatus>(line[0]);
       break;
     default:
-      throw Error(ErrorCode::PARSE_ERROR, "reply '" + line + "' does not start with % ! # or $");
+      throw Error(ErrorCode::PARSE_ERROR,
+                  "reply '" + printableBytes(line, 80) + "' does not start with % ! # or $");
   }
   r.value = line.substr(1);
   return r;

@@ -61,9 +61,9 @@ std::uint64_t ColaAReader::unsignedValue(const char* field, int bits) {
   const std::string t = token(field);
   const auto v = parseColaNumber(t);
   if (!v || *v < 0)
-    fail(field, pos_, "'" + t + "' is not an unsigned number");
+    fail(field, pos_, "'" + printableBytes(t, 40) + "' is not an unsigned number");
   if (bits < 64 && static_cast<std::uint64_t>(*v) >> bits)
-    fail(field, pos_, "'" + t + "' exceeds " + std::to_string(bits) + " bits");
+    fail(field, pos_, "'" + printableBytes(t, 40) + "' exceeds " + std::to_string(bits) + " bits");
   return static_cast<std::uint64_t>(*v);
 }
 
@@ -71,14 +71,14 @@ std::int32_t ColaAReader::signedValue(const char* field) {
   const std::string t = token(field);
   const auto v = parseColaNumber(t);
   if (!v)
-    fail(field, pos_, "'" + t + "' is not a number");
+    fail(field, pos_, "'" + printableBytes(t, 40) + "' is not a number");
   if (t[0] == '+' || t[0] == '-') {
     if (*v < INT32_MIN || *v > INT32_MAX)
-      fail(field, pos_, "'" + t + "' exceeds 32 bits");
+      fail(field, pos_, "'" + printableBytes(t, 40) + "' exceeds 32 bits");
     return static_cast<std::int32_t>(*v);
   }
   if (static_cast<std::uint64_t>(*v) >> 32)
-    fail(field, pos_, "'" + t + "' exceeds 32 bits");
+    fail(field, pos_, "'" + printableBytes(t, 40) + "' exceeds 32 bits");
   return static_cast<std::int32_t>(static_cast<std::uint32_t>(*v));
 }
 
@@ -86,7 +86,7 @@ float ColaAReader::floatValue(const char* field) {
   const std::string t = token(field);
   const auto v = parseColaNumber(t);
   if (!v || t[0] == '+' || t[0] == '-' || static_cast<std::uint64_t>(*v) >> 32)
-    fail(field, pos_, "'" + t + "' is not a hex IEEE-754 float");
+    fail(field, pos_, "'" + printableBytes(t, 40) + "' is not a hex IEEE-754 float");
   return bitsFloat(static_cast<std::uint32_t>(*v));
 }
 

@@ -92,7 +92,7 @@ bool decodeOne(const CapturedTelegram& t, Protocol protocol, bool summary, bool 
   const bool scan = (type == "sSN" || type == "sRA") && name == "LMDscandata";
   if (!scan && !bare) {
     if (summary)
-      std::cout << where(t) << " " << type << " " << lms111::printableBytes(name, 40) << "\n";
+      std::cout << where(t) << " " << type << " " << printableBytes(name, 40) << "\n";
     return true;
   }
   try {

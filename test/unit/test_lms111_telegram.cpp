@@ -243,6 +243,20 @@ TEST(DeviceMessages, SfaCodesAndStatesAreReadable) {
   EXPECT_NE(deviceStateName(12).find("12"), std::string::npos);
 }
 
+TEST(DeviceMessages, DeviceBytesInAnErrorAreEscapedNotWrittenRaw) {
+  try {
+    parseScanTelegram("sSN LMDscandata 1 1 \x1b[2J\n 0");
+    FAIL();
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\x1b'), std::string::npos) << "a raw escape byte reached the message";
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+    EXPECT_NE(m.find("\\x1B[2J\\x0A"), std::string::npos) << m;
+  }
+  EXPECT_EQ(printableBytes(std::string("a\0b\\", 4)), "a\\x00b\\x5C");
+  EXPECT_EQ(printableBytes(std::string(200, 'x'), 3), "xxx...");
+}
+
 }  // namespace
 }  // namespace lms111
 }  // namespace dormant_tree_modeling

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/common/printable.h"
+
 namespace dormant_tree_modeling {
 namespace lms111 {
 
@@ -152,10 +154,6 @@ constexpr int STATE_READY_FOR_MEASUREMENT = 7;
 /// @brief The reply type of a request type: sRN -> sRA, sWN -> sWA, sMN -> sAN, sEN -> sEA;
 /// anything else maps to itself.
 std::string replyTypeOf(const std::string& request_type);
-
-/// @brief Device bytes fit for a log line: printable ASCII as it is, every other byte as
-/// `\xNN`, cut after `max_bytes` with "...".
-std::string printableBytes(const std::string& bytes, std::size_t max_bytes = 120);
 
 /// @brief Name of a device state as `STlms` reports it (0 undefined ... 7 ready).
 std::string deviceStateName(int state);
