@@ -21,7 +21,7 @@ help:
 	@echo "make build         build everything (BUILD_TYPE=$(BUILD_TYPE))"
 	@echo "make test          setup + build + every gtest and rostest; ends 'N passed, N failed'"
 	@echo "make bench         setup + build + benchmarks (timings, memory, accuracy tables)"
-	@echo "make fuzz          libFuzzer on the LMS111 parser and framers (FUZZ_SECONDS=60; installs clang)"
+	@echo "make fuzz          libFuzzer: LMS111 bytes and recordings, cloud/JSON files, Ensemble replies (FUZZ_SECONDS=60 each)"
 	@echo "make demo          setup + build + a synthetic tree scanned, modeled and scored -> results/"
 	@echo "make format        clang-format the sources in place"
 	@echo "make format-check  fail on any badly formatted source; check the core has no ROS"
