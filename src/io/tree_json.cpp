@@ -74,7 +74,8 @@ void checkFormat(const json& doc, const char* expected) {
 json parse(const std::string& text) {
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number no double holds (1e499).
     fail(std::string("invalid JSON: ") + e.what());
   }
 }
@@ -203,7 +204,20 @@ std::string modelToJson(const modeling::TreeModel& model, const Eigen::Vector3d&
   return doc.dump(2) + "\n";
 }
 
-modeling::TreeModel modelFromJson(const std::string& text) {
+namespace {
+
+// A value of the wrong JSON type anywhere in a document ("id": "abc") is a parse error that
+// names nlohmann's reason, not an exception of another type.
+template <typename F>
+auto guarded(F read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const json::exception& e) {
+    fail(std::string("invalid document: ") + e.what());
+  }
+}
+
+modeling::TreeModel modelFromDocument(const std::string& text) {
   const json doc = parse(text);
   if (!doc.is_object())
     fail("model document is not a JSON object");
@@ -251,6 +265,12 @@ modeling::TreeModel modelFromJson(const std::string& text) {
   return model;
 }
 
+}  // namespace
+
+modeling::TreeModel modelFromJson(const std::string& text) {
+  return guarded([&] { return modelFromDocument(text); });
+}
+
 std::string truthToJson(const evaluation::GroundTruth& truth) {
   json primaries = json::array();
   for (const auto& p : truth.primary_branches)
@@ -266,7 +286,9 @@ std::string truthToJson(const evaluation::GroundTruth& truth) {
   return doc.dump(1) + "\n";
 }
 
-evaluation::GroundTruth truthFromJson(const std::string& text) {
+namespace {
+
+evaluation::GroundTruth truthFromDocument(const std::string& text) {
   const json doc = parse(text);
   if (!doc.is_object())
     fail("truth document is not a JSON object");
@@ -276,6 +298,12 @@ evaluation::GroundTruth truthFromJson(const std::string& text) {
   truth.primary_branches = polylinesFromJson(doc, "primary_branches");
   truth.minor_branches = polylinesFromJson(doc, "minor_branches");
   return truth;
+}
+
+}  // namespace
+
+evaluation::GroundTruth truthFromJson(const std::string& text) {
+  return guarded([&] { return truthFromDocument(text); });
 }
 
 std::string readTextFile(const std::string& path) {

@@ -20,6 +20,9 @@ namespace ros_layer {
 
 namespace {
 
+// How often the end of the input is looked for, s.
+constexpr double END_OF_INPUT_CHECK_S = 1.0;
+
 registration::RegistrationConfig loadConfig(ros::NodeHandle& pnh) {
   const std::string file = pnh.param<std::string>("config_file", "");
   if (file.empty()) {
@@ -57,6 +60,7 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   expected_views_ = pnh.param<int>("expected_views", 0);
   hint_timeout_ = pnh.param<double>("hint_timeout", 0.5);
   finished_wait_ = pnh.param<double>("finished_wait", 10.0);
+  end_of_input_timeout_ = pnh.param<double>("end_of_input_timeout", 0.0);
   if (expected_views_ < 0)
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "~expected_views must be >= 0 (0: no automatic "
@@ -65,6 +69,8 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~hint_timeout must be >= 0 s");
   if (!(finished_wait_ >= 0))
     throw Error(ErrorCode::INVALID_ARGUMENT, "~finished_wait must be >= 0 s");
+  if (!(end_of_input_timeout_ >= 0))
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~end_of_input_timeout must be >= 0 s (0: off)");
   if (tree_frame_.empty() || orchard_frame_.empty() || tree_frame_ == orchard_frame_)
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "~tree_frame and ~orchard_frame must be two different, non-empty frame names");
@@ -83,6 +89,11 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   diagnostics_.add("registration", this, &RegistrationNode::diagnose);
   diagnostics_timer_ =
       nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  if (end_of_input_timeout_ > 0) {
+    clock_still_since_ = ros::WallTime::now();
+    input_timer_ = nh.createWallTimer(ros::WallDuration(END_OF_INPUT_CHECK_S),
+                                      [this](const ros::WallTimerEvent&) { checkEndOfInput(); });
+  }
   ROS_INFO("registration: collecting views on %s; registers on ~register%s%s",
            view_sub_.getTopic().c_str(),
            expected_views_ > 0 ? (" or after " + std::to_string(expected_views_) + " views").c_str()
@@ -186,6 +197,32 @@ void RegistrationNode::finishedWaitExpired() {
   std::string why;
   if (!startRegistration(why))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
+}
+
+// A replay whose bag ended early, was cut off, or lacks the end-of-plan record stops the
+// clock without a "finished": the views that arrived are registered rather than waited on.
+void RegistrationNode::checkEndOfInput() {
+  const ros::Time now = ros::Time::now();
+  if (now != last_clock_) {
+    last_clock_ = now;
+    clock_still_since_ = ros::WallTime::now();
+    return;
+  }
+  const double still = (ros::WallTime::now() - clock_still_since_).toSec();
+  std::size_t views = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (still < end_of_input_timeout_ || busy_ || views_.empty())
+      return;
+    views = views_.size();
+  }
+  ROS_WARN(
+      "registration: the input stopped (no clock for %.0f s) before the plan reported "
+      "finished: registering the %zu views that arrived",
+      still, views);
+  std::string why;
+  if (!startRegistration(why))
+    ROS_WARN("registration: %s", why.c_str());
 }
 
 bool RegistrationNode::registerService(std_srvs::Trigger::Request&,

@@ -146,6 +146,23 @@ evaluation::GroundTruth sampleTruth() {
   return t;
 }
 
+TEST(ModelJson, ANumberNoDoubleHoldsOrAValueOfTheWrongTypeIsAParseError) {
+  // Found by make fuzz: nlohmann's out_of_range for 1e499 escaped as another exception type.
+  for (const char* text :
+       {"\n1e499\n",
+        R"({"format": "dormant_tree_model/1", "units": "m", "trunk": [{"id": "abc"}]})"}) {
+    for (const auto& read : {std::function<void()>([&] { io::modelFromJson(text); }),
+                             std::function<void()>([&] { io::truthFromJson(text); })}) {
+      try {
+        read();
+        ADD_FAILURE() << text;
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR) << e.what();
+      }
+    }
+  }
+}
+
 TEST(PoseJson, RejectsAZeroOrScaledQuaternionAndNonFiniteNumbers) {
   const auto pose = [](const std::string& text) {
     return io::poseFromJson(nlohmann::json::parse(text), "guess_pose");

@@ -51,6 +51,7 @@ class RegistrationNode {
   void progressCallback(const std_msgs::StringConstPtr& msg);
   /// The plan's end named views that have not arrived within `~finished_wait`.
   void finishedWaitExpired();
+  void checkEndOfInput();
   bool registerService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   /// Starts a registration of the collected views on the worker; false (and why) when busy
@@ -76,7 +77,10 @@ class RegistrationNode {
   ros::ServiceServer register_srv_, reset_srv_;
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;
-  ros::WallTimer finished_timer_;
+  ros::WallTimer finished_timer_, input_timer_;
+  double end_of_input_timeout_ = 0.0;  // s of wall time without the clock advancing; 0 off
+  ros::Time last_clock_;
+  ros::WallTime clock_still_since_;
 
   std::mutex mutex_;
   std::vector<registration::ViewInput> views_;
