@@ -4,6 +4,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <topic_tools/shape_shifter.h>
 
 #include <cstdlib>
 #include <iomanip>
@@ -61,6 +62,7 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   hint_timeout_ = pnh.param<double>("hint_timeout", 0.5);
   finished_wait_ = pnh.param<double>("finished_wait", 10.0);
   end_of_input_timeout_ = pnh.param<double>("end_of_input_timeout", 0.0);
+  const std::string input_topic = pnh.param<std::string>("input_watch_topic", "");
   if (expected_views_ < 0)
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "~expected_views must be >= 0 (0: no automatic "
@@ -89,8 +91,13 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   diagnostics_.add("registration", this, &RegistrationNode::diagnose);
   diagnostics_timer_ =
       nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
-  if (end_of_input_timeout_ > 0) {
-    clock_still_since_ = ros::WallTime::now();
+  if (end_of_input_timeout_ > 0 && !input_topic.empty()) {
+    last_input_ = ros::WallTime::now();
+    input_sub_ = nh.subscribe<topic_tools::ShapeShifter>(
+        input_topic, 10, [this](const topic_tools::ShapeShifter::ConstPtr&) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          last_input_ = ros::WallTime::now();
+        });
     input_timer_ = nh.createWallTimer(ros::WallDuration(END_OF_INPUT_CHECK_S),
                                       [this](const ros::WallTimerEvent&) { checkEndOfInput(); });
   }
@@ -199,27 +206,24 @@ void RegistrationNode::finishedWaitExpired() {
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
 }
 
-// A replay whose bag ended early, was cut off, or lacks the end-of-plan record stops the
-// clock without a "finished": the views that arrived are registered rather than waited on.
+// A replay whose bag ended early, was cut off, or lacks the end-of-plan record goes quiet
+// without a "finished": the views that arrived are registered rather than waited on. Quiet
+// means no message on the watched topic (the stage's joint states, present all through an
+// acquisition), so a long pause between two views is not taken for the end.
 void RegistrationNode::checkEndOfInput() {
-  const ros::Time now = ros::Time::now();
-  if (now != last_clock_) {
-    last_clock_ = now;
-    clock_still_since_ = ros::WallTime::now();
-    return;
-  }
-  const double still = (ros::WallTime::now() - clock_still_since_).toSec();
+  double quiet = 0.0;
   std::size_t views = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (still < end_of_input_timeout_ || busy_ || views_.empty())
+    quiet = (ros::WallTime::now() - last_input_).toSec();
+    if (quiet < end_of_input_timeout_ || busy_ || views_.empty())
       return;
     views = views_.size();
   }
   ROS_WARN(
-      "registration: the input stopped (no clock for %.0f s) before the plan reported "
+      "registration: the input went quiet (%s silent for %.0f s) before the plan reported "
       "finished: registering the %zu views that arrived",
-      still, views);
+      input_sub_.getTopic().c_str(), quiet, views);
   std::string why;
   if (!startRegistration(why))
     ROS_WARN("registration: %s", why.c_str());

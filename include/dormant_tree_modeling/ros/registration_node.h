@@ -78,9 +78,9 @@ class RegistrationNode {
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;
   ros::WallTimer finished_timer_, input_timer_;
-  double end_of_input_timeout_ = 0.0;  // s of wall time without the clock advancing; 0 off
-  ros::Time last_clock_;
-  ros::WallTime clock_still_since_;
+  double end_of_input_timeout_ = 0.0;  // s without a message on input_sub_'s topic; 0 off
+  ros::Subscriber input_sub_;
+  ros::WallTime last_input_;
 
   std::mutex mutex_;
   std::vector<registration::ViewInput> views_;
