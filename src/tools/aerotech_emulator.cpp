@@ -38,6 +38,9 @@ int main(int argc, char** argv) {
     po::variables_map vm;
     if (tools::parseOrHelp(static_cast<int>(args.size()), args.data(), desc, vm))
       return 0;
+    if (port < 0 || port > 65535)
+      throw Error(ErrorCode::INVALID_ARGUMENT,
+                  "--port must be in 0..65535, not " + std::to_string(port));
     faults.invalid_commands.insert(invalid.begin(), invalid.end());
     auto controller =
         std::make_shared<aerotech::EmulatedEnsemble>(aerotech::defaultStageAxes(), faults);
