@@ -54,6 +54,12 @@ ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& optio
       ViewInput in;
       in.name = v.at("name").get<std::string>();
       in.station = v.value("platform_index", v.value("index", 0));
+      // Keys read by other tools must hold what views.json documents, not any JSON value.
+      for (const char* key : {"slide", "points"}) {
+        if (v.contains(key) && !v.at(key).is_number())
+          throw Error(ErrorCode::PARSE_ERROR, index_path + ": view " + in.name + ": '" + key +
+                                                  "' must be a number, is " + v.at(key).dump());
+      }
       const auto truth = io::poseFromJson(v, "true_pose");
       const auto guess = io::poseFromJson(v, "guess_pose");
       f.true_poses.push_back(truth);
@@ -92,6 +98,10 @@ ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& optio
                              [floor](const Eigen::Vector3d& q) { return q.z() < floor; }),
               in.points.end());
         }
+      }
+      if (in.points.size() < FEW_VIEW_POINTS) {
+        f.warnings.push_back("view " + in.name + " holds " + std::to_string(in.points.size()) +
+                             " points (after the crop): it adds nothing to its station");
       }
       f.views.push_back(std::move(in));
     }

@@ -54,6 +54,8 @@ int main(int argc, char** argv) {
     fo.use_guesses = config.use_hints;
     const auto folder = registration::readViewFolder(dir, fo);
     std::cout << "register_views: " << folder.views.size() << " views from " << dir << "\n";
+    for (const auto& w : folder.warnings)
+      std::cerr << "register_views: warning: " << w << "\n";
     const auto result = registration::registerViews(folder.views, config);
     std::optional<registration::PoseErrors> errors;
     const auto e = registration::poseErrors(result, folder.true_poses);

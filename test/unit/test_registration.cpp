@@ -2,17 +2,25 @@
 // from guesses 0.5 m and 20 deg off or none, and leave out views that do not belong.
 #include <gtest/gtest.h>
 
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "dormant_tree_modeling/acquisition/range_image.h"
 #include "dormant_tree_modeling/acquisition/target_isolation.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/registration/coarse_search.h"
 #include "dormant_tree_modeling/registration/icp.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
+#include "temp_dir.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
@@ -234,6 +242,38 @@ TEST(Registration, RejectsBadInputWithClearErrors) {
   coarse.cell = 0;
   EXPECT_THROW(coarse.validate(), Error);
   EXPECT_THROW(loadRegistrationConfig("/nonexistent/registration.yaml"), Error);
+}
+
+TEST(ViewFolder, WarnsOfANearlyEmptyViewAndRefusesMistypedKeys) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("views"));
+  Cloud full, single;
+  for (int i = 0; i < 500; ++i)
+    full.push_back(pcl::PointXYZ(0.001f * i, 0.0f, 0.5f + 0.002f * i));
+  single.push_back(pcl::PointXYZ(0.0f, 0.0f, 1.0f));
+  io::writeCloud(dir.file("views/a.pcd"), full);
+  io::writeCloud(dir.file("views/b.pcd"), single);
+  const std::string pose =
+      R"("guess_pose": {"translation": [0, 0, 0], "rotation_xyzw": [0, 0, 0, 1]})";
+  const auto index = [&](const std::string& b_extra) {
+    std::ofstream(dir.file("views.json"))
+        << R"({"views": [{"name": "a", "platform_index": 0, "slide": 0.1, )" << pose
+        << R"(}, {"name": "b", "platform_index": 0, )" << b_extra << pose << "}]}";
+  };
+  index(R"("slide": 0.2, )");
+  const ViewFolder f = readViewFolder(dir.file(""));
+  ASSERT_EQ(f.views.size(), 2u);
+  ASSERT_EQ(f.warnings.size(), 1u);
+  EXPECT_NE(f.warnings[0].find("view b holds 1 points"), std::string::npos) << f.warnings[0];
+  index(R"("slide": "abc", )");
+  try {
+    readViewFolder(dir.file(""));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR);
+    EXPECT_NE(std::string(e.what()).find("'slide' must be a number"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

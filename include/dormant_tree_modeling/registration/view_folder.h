@@ -36,7 +36,13 @@ struct ViewFolder {
   std::vector<ViewInput> views;
   /// Per view, from views.json when present: the true pose and the guess (view -> world).
   std::vector<std::optional<Eigen::Isometry3d>> true_poses, guess_poses;
+  /// What looked wrong but did not stop the reading (a view with almost no points).
+  std::vector<std::string> warnings;
 };
+
+/// @brief A view with fewer points than this (after the crop) is worth a warning: it adds
+/// nothing to its station and may be a file written by mistake.
+constexpr std::size_t FEW_VIEW_POINTS = 100;
 
 /// @brief Read a folder of views. Views sharing a platform_index form a station; their poses
 /// within it come from the guesses (the slide moves are exact; only the platform is off).
