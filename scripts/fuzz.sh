@@ -10,8 +10,8 @@ out="$root/.build/fuzz"
 seconds="${FUZZ_SECONDS:-60}"
 bash "$root/scripts/setup.sh" "$root/scripts/debian-packages-fuzz.txt"
 flags=(-std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
-  -I"$root/include")
-common=("$root/src/common/error.cpp" "$root/src/common/printable.cpp")
+  -I"$root/include" -I/usr/include/eigen3)
+common=("$root/src/common/error.cpp" "$root/src/common/printable.cpp" "$root/src/common/statistics.cpp")
 
 build() {  # name, sources..., then -- and link flags
   local name=$1
@@ -52,7 +52,7 @@ build lms111_fuzz "${lms111[@]}"
 files=("$root/src/io/point_cloud_io.cpp" "$root/src/io/pcl_file_io.cpp" "$root/src/io/xyz_text_io.cpp"
   "$root/src/io/tree_json.cpp" "$root/src/modeling/tree_model.cpp"
   "$root/src/aerotech/ascii_protocol.cpp")
-build files_fuzz "${files[@]}" -- -I/usr/include/pcl-1.13 -I/usr/include/eigen3 -lpcl_io \
+build files_fuzz "${files[@]}" -- -I/usr/include/pcl-1.13 -lpcl_io \
   -lpcl_common -lboost_system
 status=0
 run lms111_fuzz "$root/fuzz/corpus" || status=$?

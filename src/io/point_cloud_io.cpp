@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "raw_points.h"
 
 namespace dormant_tree_modeling {
@@ -51,17 +52,10 @@ constexpr double OFFSET_Z_QUANTILE = 0.01;
 // quantile in z, of a sample, so that one stray point cannot move it; whole metres, so that it
 // is exact in any printed form.
 Eigen::Vector3d recentringOffset(const detail::RawPoints& pts) {
-  const std::size_t stride = std::max<std::size_t>(1, pts.size() / OFFSET_SAMPLE);
   Eigen::Vector3d offset;
-  std::vector<double> v;
   for (int a = 0; a < 3; ++a) {
-    v.clear();
-    for (std::size_t i = 0; i < pts.size(); i += stride)
-      v.push_back(pts[i](a));
-    const double q = a == 2 ? OFFSET_Z_QUANTILE : 0.5;
-    const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + k, v.end());
-    offset(a) = std::round(v[k]);
+    std::vector<double> sample = axisSample(pts, a, OFFSET_SAMPLE);
+    offset(a) = std::round(quantileInPlace(sample, a == 2 ? OFFSET_Z_QUANTILE : 0.5));
   }
   return offset;
 }

@@ -13,9 +13,6 @@ namespace lms111 {
 
 namespace {
 
-const std::string COLA_B_MAGIC(4, '\x02');
-constexpr std::size_t COLA_B_HEADER = 8;  // magic + 32-bit length
-
 int hexValue(char c) {
   if (c >= '0' && c <= '9')
     return c - '0';
@@ -91,33 +88,30 @@ std::vector<CapturedTelegram> cutColaBStream(const std::string& bytes) {
   std::vector<CapturedTelegram> out;
   std::size_t pos = bytes.find(COLA_B_MAGIC);
   while (pos != std::string::npos) {
-    if (bytes.size() - pos < COLA_B_HEADER) {
+    if (bytes.size() - pos < COLA_B_HEADER_BYTES) {
       addFailure(out, pos, "cut-off frame (no length field)");
       break;
     }
-    std::uint64_t length = 0;
-    for (std::size_t i = 4; i < COLA_B_HEADER; ++i)
-      length = (length << 8) | static_cast<unsigned char>(bytes[pos + i]);
-    if (length + 1 > bytes.size() - pos - COLA_B_HEADER) {
+    const std::uint64_t length = colaBDeclaredLength(bytes.data() + pos);
+    const std::size_t left = bytes.size() - pos - COLA_B_HEADER_BYTES;
+    if (length + 1 > left) {
       addFailure(out, pos,
                  "cut-off frame (" + std::to_string(length) + " payload bytes declared, " +
-                     std::to_string(bytes.size() - pos - COLA_B_HEADER) + " left)");
+                     std::to_string(left) + " left)");
       // A corrupt length can swallow good frames: resynchronise just past this magic.
       pos = bytes.find(COLA_B_MAGIC, pos + 1);
       continue;
     }
-    const std::size_t end = pos + COLA_B_HEADER + length + 1;
-    char sum = 0;
-    for (std::size_t i = pos + COLA_B_HEADER; i + 1 < end; ++i)
-      sum = static_cast<char>(sum ^ bytes[i]);
-    if (sum != bytes[end - 1]) {
+    const char* payload = bytes.data() + pos + COLA_B_HEADER_BYTES;
+    if (colaBChecksum(payload, length) != payload[length]) {
       addFailure(out, pos, "bad checksum");
       pos = bytes.find(COLA_B_MAGIC, pos + 1);
       continue;
     }
+    const std::size_t end = pos + COLA_B_HEADER_BYTES + length + 1;
     CapturedTelegram t;
     t.offset = t.last_offset = pos;
-    t.payload = bytes.substr(pos + COLA_B_HEADER, length);
+    t.payload.assign(payload, length);
     out.push_back(std::move(t));
     pos = bytes.find(COLA_B_MAGIC, end);
   }

@@ -10,8 +10,6 @@ namespace lms111 {
 
 namespace {
 
-const char COLA_B_MAGIC[4] = {0x02, 0x02, 0x02, 0x02};
-
 bool isHexDigit(char c) {
   return (c >= '0' && c <= '9') || (c >= 'A' && c <= 'F') || (c >= 'a' && c <= 'f');
 }
@@ -36,16 +34,29 @@ std::string frameColaA(const std::string& text) {
   return std::string(1, STX) + text + std::string(1, ETX);
 }
 
+const std::string COLA_B_MAGIC(4, '\x02');
+
+char colaBChecksum(const char* payload, std::size_t size) {
+  char sum = 0;
+  for (std::size_t i = 0; i < size; ++i)
+    sum = static_cast<char>(sum ^ payload[i]);
+  return sum;
+}
+
+std::uint32_t colaBDeclaredLength(const char* frame) {
+  std::uint32_t length = 0;
+  for (std::size_t i = COLA_B_MAGIC.size(); i < COLA_B_HEADER_BYTES; ++i)
+    length = (length << 8) | static_cast<unsigned char>(frame[i]);
+  return length;
+}
+
 std::string frameColaB(const std::string& payload) {
-  std::string out(COLA_B_MAGIC, 4);
+  std::string out = COLA_B_MAGIC;
   const auto n = static_cast<std::uint32_t>(payload.size());
   for (int shift = 24; shift >= 0; shift -= 8)
     out.push_back(static_cast<char>((n >> shift) & 0xFF));
   out += payload;
-  char sum = 0;
-  for (const char c : payload)
-    sum = static_cast<char>(sum ^ c);
-  out.push_back(sum);
+  out.push_back(colaBChecksum(payload.data(), payload.size()));
   return out;
 }
 
@@ -107,9 +118,8 @@ void ColaBFramer::feed(const char* data, std::size_t size) {
 }
 
 std::optional<std::string> ColaBFramer::next() {
-  const std::string magic(COLA_B_MAGIC, 4);
   for (;;) {
-    const std::size_t start = buffer_.find(magic, pos_);
+    const std::size_t start = buffer_.find(COLA_B_MAGIC, pos_);
     if (start == std::string::npos) {
       // Keep a possible beginning of the magic at the end.
       std::size_t keep = 0;
@@ -123,33 +133,29 @@ std::optional<std::string> ColaBFramer::next() {
     }
     skipped_ += start - pos_;
     pos_ = start;
-    if (buffer_.size() - pos_ < 8) {
+    if (buffer_.size() - pos_ < COLA_B_HEADER_BYTES) {
       compact(buffer_, pos_);
       return std::nullopt;
     }
-    std::uint32_t length = 0;
-    for (std::size_t i = 4; i < 8; ++i)
-      length = (length << 8) | static_cast<unsigned char>(buffer_[pos_ + i]);
+    const std::uint32_t length = colaBDeclaredLength(buffer_.data() + pos_);
     if (length > max_payload_) {
       ++dropped_;
       ++pos_;  // resynchronise on the next magic
       continue;
     }
-    if (buffer_.size() - pos_ < 8 + static_cast<std::size_t>(length) + 1) {
+    const std::size_t frame_bytes = COLA_B_HEADER_BYTES + static_cast<std::size_t>(length) + 1;
+    if (buffer_.size() - pos_ < frame_bytes) {
       compact(buffer_, pos_);
       return std::nullopt;
     }
-    const char* payload = buffer_.data() + pos_ + 8;
-    char sum = 0;
-    for (std::uint32_t i = 0; i < length; ++i)
-      sum = static_cast<char>(sum ^ payload[i]);
-    if (sum != payload[length]) {
+    const char* payload = buffer_.data() + pos_ + COLA_B_HEADER_BYTES;
+    if (colaBChecksum(payload, length) != payload[length]) {
       ++bad_checksum_;
       ++pos_;
       continue;
     }
     std::string out(payload, length);
-    pos_ += 8 + static_cast<std::size_t>(length) + 1;
+    pos_ += frame_bytes;
     compact(buffer_, pos_);
     return out;
   }

@@ -333,12 +333,6 @@ class Lms111Driver::Session {
   }
 
  private:
-  // A scan, as opposed to the events and late replies a device interleaves with them.
-  bool isScanTelegram(const std::string& payload) const {
-    return payload.compare(0, 16, "sSN LMDscandata ") == 0 ||
-           payload.compare(0, 16, "sRA LMDscandata ") == 0;
-  }
-
   // Events (sSN LIDoutputstate, LIDinputstate, LFErec, ...) are counted; an sFA while
   // streaming is logged.
   void noteOtherTelegram(const std::string& payload) {

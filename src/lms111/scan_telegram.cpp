@@ -79,6 +79,16 @@ const ScanChannel* ScanTelegram::channel(const std::string& name) const {
   return nullptr;
 }
 
+bool isScanTelegram(const std::string& payload) {
+  static const std::string NAME = "LMDscandata";
+  constexpr std::size_t TYPE_AND_SPACE = 4;  // "sSN " or "sRA "
+  const bool typed = payload.compare(0, TYPE_AND_SPACE, "sSN ") == 0 ||
+                     payload.compare(0, TYPE_AND_SPACE, "sRA ") == 0;
+  const std::size_t end = TYPE_AND_SPACE + NAME.size();
+  return typed && payload.compare(TYPE_AND_SPACE, NAME.size(), NAME) == 0 &&
+         (payload.size() == end || payload[end] == ' ');
+}
+
 ScanTelegram parseScanTelegram(const std::string& payload, Protocol protocol) {
   const auto reader = makeReader(protocol, payload);
   FieldReader& r = *reader;

@@ -334,20 +334,11 @@ std::vector<char> floatingMaskWith(const Points& pts, double radius, int min_nei
 std::size_t removeFarOutliers(Points& pts) {
   if (pts.size() < 2)
     return 0;
-  const std::size_t stride = std::max<std::size_t>(1, pts.size() / FAR_OUTLIER_SAMPLE);
   Eigen::Vector3d lo, hi;
-  std::vector<double> values;
   for (int a = 0; a < 3; ++a) {
-    values.clear();
-    for (std::size_t i = 0; i < pts.size(); i += stride)
-      values.push_back(pts[i](a));
-    const auto at = [&](double q) {
-      const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1));
-      std::nth_element(values.begin(), values.begin() + k, values.end());
-      return values[k];
-    };
-    lo(a) = at(FAR_OUTLIER_QUANTILE);
-    hi(a) = at(1.0 - FAR_OUTLIER_QUANTILE);
+    std::vector<double> sample = axisSample(pts, a, FAR_OUTLIER_SAMPLE);
+    lo(a) = quantileInPlace(sample, FAR_OUTLIER_QUANTILE);
+    hi(a) = quantileInPlace(sample, 1.0 - FAR_OUTLIER_QUANTILE);
   }
   const Eigen::Vector3d margin = (FAR_OUTLIER_MARGIN * (hi - lo))
                                      .cwiseMax(Eigen::Vector3d::Constant(FAR_OUTLIER_MIN_MARGIN_M));

@@ -88,9 +88,8 @@ std::string summaryOf(const lms111::ScanTelegram& s) {
 // One telegram: a summary line, or its JSON when it is a scan. False when it should have
 // decoded and did not.
 bool decodeOne(const CapturedTelegram& t, Protocol protocol, bool summary, bool bare) {
-  const auto [type, name] = lms111::commandWords(t.payload);
-  const bool scan = (type == "sSN" || type == "sRA") && name == "LMDscandata";
-  if (!scan && !bare) {
+  if (!lms111::isScanTelegram(t.payload) && !bare) {
+    const auto [type, name] = lms111::commandWords(t.payload);
     if (summary)
       std::cout << where(t) << " " << type << " " << printableBytes(name, 40) << "\n";
     return true;

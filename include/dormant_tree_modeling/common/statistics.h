@@ -1,5 +1,7 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 namespace dormant_tree_modeling {
@@ -7,5 +9,14 @@ namespace dormant_tree_modeling {
 /// @brief The median of the values (the upper one of the two middle values for an even
 /// count), 0 for none. Takes the values by copy: it reorders them.
 double median(std::vector<double> values);
+
+/// @brief The value of rank floor(q (n - 1)) among the values, 0 <= q <= 1; 0 for none.
+/// Reorders them (nth_element), so that several quantiles of one sample cost little.
+double quantileInPlace(std::vector<double>& values, double q);
+
+/// @brief One coordinate (0 x, 1 y, 2 z) of every (n / max_samples)-th point: a sample whose
+/// quantiles one stray point cannot move and whose size stays near max_samples.
+std::vector<double> axisSample(const std::vector<Eigen::Vector3d>& points, int axis,
+                               std::size_t max_samples);
 
 }  // namespace dormant_tree_modeling

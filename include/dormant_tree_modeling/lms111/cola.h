@@ -30,6 +30,17 @@ std::string frameColaA(const std::string& text);
 /// payload bytes.
 std::string frameColaB(const std::string& payload);
 
+/// @brief The four bytes that start a CoLa-B frame, and the header they begin (magic and the
+/// 32-bit payload length).
+extern const std::string COLA_B_MAGIC;
+constexpr std::size_t COLA_B_HEADER_BYTES = 8;
+
+/// @brief A CoLa-B frame's checksum: the XOR of its payload bytes.
+char colaBChecksum(const char* payload, std::size_t size);
+
+/// @brief The payload length a CoLa-B header declares (the 4 bytes after the magic at `frame`).
+std::uint32_t colaBDeclaredLength(const char* frame);
+
 /// @brief A telegram framed for the protocol (frameColaA or frameColaB).
 std::string frame(Protocol protocol, const std::string& payload);
 

@@ -90,6 +90,10 @@ struct ScanTelegram {
   }
 };
 
+/// @brief Whether a payload (either protocol) is a scan, `sSN` or `sRA LMDscandata`, as opposed
+/// to the replies and events a device interleaves with scans.
+bool isScanTelegram(const std::string& payload);
+
 /// @brief Decode an `LMDscandata` telegram payload (without STX/ETX or the CoLa-B frame) by
 /// walking its structure: any number of encoders and channels, the optional blocks, strings
 /// with spaces. CoLa-B carries the same fields big-endian with these widths: version, device
