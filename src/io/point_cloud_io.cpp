@@ -134,6 +134,15 @@ CloudReadResult readCloud(const std::string& path, const CloudReadOptions& optio
   return result;
 }
 
+std::vector<Eigen::Vector3d> readPointsInFileFrame(const std::string& path) {
+  const CloudReadResult cloud = readCloud(path);
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(cloud.cloud->size());
+  for (const auto& p : cloud.cloud->points)
+    points.push_back(p.getVector3fMap().cast<double>() + cloud.offset);
+  return points;
+}
+
 void writeCloud(const std::string& path, const Cloud& cloud, const Eigen::Vector3d& offset) {
   switch (cloudFormatFromPath(path)) {
     case CloudFormat::XYZ:

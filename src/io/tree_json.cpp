@@ -180,6 +180,39 @@ std::vector<evaluation::Polyline> polylinesFromJson(const json& doc, const char*
 
 }  // namespace
 
+namespace {
+
+json correctionJson(const modeling::DiameterCorrection& c) {
+  return {
+      {"calibration", c.calibration.empty() ? json(nullptr) : json(c.calibration)},
+      {"calibration_hash", c.calibration_hash.empty() ? json(nullptr) : json(c.calibration_hash)},
+      {"noise_sigma_m", c.noise_sigma},
+      {"warnings", c.warnings}};
+}
+
+/// The optional "diameter_correction" of a model document; absent in older files.
+modeling::DiameterCorrection correctionFromJson(const json& doc) {
+  modeling::DiameterCorrection c;
+  if (!doc.contains("diameter_correction") || !doc["diameter_correction"].is_object())
+    return c;
+  const json& j = doc["diameter_correction"];
+  if (j.contains("calibration") && j["calibration"].is_string())
+    c.calibration = j["calibration"].get<std::string>();
+  if (j.contains("calibration_hash") && j["calibration_hash"].is_string())
+    c.calibration_hash = j["calibration_hash"].get<std::string>();
+  if (j.contains("noise_sigma_m") && j["noise_sigma_m"].is_number())
+    c.noise_sigma = j["noise_sigma_m"].get<double>();
+  if (j.contains("warnings") && j["warnings"].is_array()) {
+    for (const auto& w : j["warnings"]) {
+      if (w.is_string())
+        c.warnings.push_back(w.get<std::string>());
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
 std::string modelToJson(const modeling::TreeModel& model, const Eigen::Vector3d& offset) {
   json trunk = json::array();
   for (const auto& c : model.trunk)
@@ -200,7 +233,8 @@ std::string modelToJson(const modeling::TreeModel& model, const Eigen::Vector3d&
            {"input_points", model.input_points},
            {"trunk", trunk},
            {"primary_branches", branches},
-           {"runtime_s", model.runtime_s}};
+           {"runtime_s", model.runtime_s},
+           {"diameter_correction", correctionJson(model.correction)}};
   return doc.dump(2) + "\n";
 }
 
@@ -262,6 +296,7 @@ modeling::TreeModel modelFromDocument(const std::string& text) {
       b.measurement.prune = j["prune"].get<bool>();
     model.primary_branches.push_back(b);
   }
+  model.correction = correctionFromJson(doc);
   return model;
 }
 

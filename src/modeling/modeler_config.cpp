@@ -103,45 +103,11 @@ const std::map<std::string, Setter>& setters() {
       {"prune_ratio", setter(&C::prune_ratio)},
       {"seed", setter(&C::seed)},
       {"branch_raw_radius", setter(&C::branch_raw_radius)},
-      {"trunk_calibration_radii",
-       [](C& c, const YAML::Node& n) { c.trunk_calibration.radii = n.as<std::vector<double>>(); }},
-      {"trunk_calibration_noise",
-       [](C& c, const YAML::Node& n) { c.trunk_calibration.noise = n.as<std::vector<double>>(); }},
-      {"trunk_calibration_bias",
-       [](C& c, const YAML::Node& n) { c.trunk_calibration.bias = n.as<std::vector<double>>(); }},
-      {"branch_calibration_radii",
-       [](C& c, const YAML::Node& n) { c.branch_calibration.radii = n.as<std::vector<double>>(); }},
-      {"branch_calibration_noise",
-       [](C& c, const YAML::Node& n) { c.branch_calibration.noise = n.as<std::vector<double>>(); }},
-      {"branch_calibration_bias",
-       [](C& c, const YAML::Node& n) { c.branch_calibration.bias = n.as<std::vector<double>>(); }},
   };
   return table;
 }
 
 }  // namespace
-
-RadiusCalibration defaultTrunkCalibration() {
-  // calibrate_diameters --radii-mm 5,7.5,10,15,20,30,45,70,100 --noise-mm 3,6,12
-  RadiusCalibration c;
-  c.radii = {0.005, 0.0075, 0.01, 0.015, 0.02, 0.03, 0.045, 0.07, 0.1};
-  c.noise = {0.00415, 0.00610, 0.00882};
-  c.bias = {0.00449, 0.00483, 0.00362, 0.00225, 0.00201, 0.00104, 0.00030, 0.00016, 0.00005,
-            0.00716, 0.00562, 0.00392, 0.00424, 0.00343, 0.00242, 0.00157, 0.00105, 0.00060,
-            0.00750, 0.00607, 0.00410, 0.00389, 0.00423, 0.00292, 0.00263, 0.00183, 0.00134};
-  return c;
-}
-
-RadiusCalibration defaultBranchCalibration() {
-  // calibrate_diameters --branch-radii-mm 3,4,5,6.5,8,10,12.5,15,20 --noise-mm 3,6,12
-  RadiusCalibration c;
-  c.radii = {0.00300, 0.00400, 0.00500, 0.00650, 0.00800, 0.01000, 0.01250, 0.01500, 0.02000};
-  c.noise = {0.00506, 0.00681, 0.00955};
-  c.bias = {0.00518, 0.00447, 0.00387, 0.00328, 0.00289, 0.00234, 0.00159, 0.00126, -0.00012,
-            0.00598, 0.00529, 0.00468, 0.00403, 0.00351, 0.00291, 0.00215, 0.00159, 0.00036,
-            0.00815, 0.00761, 0.00667, 0.00592, 0.00545, 0.00440, 0.00336, 0.00258, 0.00110};
-  return c;
-}
 
 ModelerConfig ModelerConfig::paper() {
   ModelerConfig c;
@@ -213,14 +179,22 @@ void ModelerConfig::validate() const {
 
 ModelerConfig loadModelerConfig(const std::string& path) {
   ModelerConfig config;
-  forEachYamlEntry(path, "tree_modeler", "tree modeler parameter",
-                   [&](const std::string& key, const YAML::Node& v) {
-                     const auto it = setters().find(key);
-                     if (it == setters().end())
-                       return false;
-                     it->second(config, v);
-                     return true;
-                   });
+  forEachYamlEntry(
+      path, "tree_modeler", "tree modeler parameter",
+      [&](const std::string& key, const YAML::Node& v) {
+        if (key.rfind("trunk_calibration_", 0) == 0 || key.rfind("branch_calibration_", 0) == 0) {
+          throw Error(ErrorCode::PARSE_ERROR,
+                      path + ": '" + key +
+                          "' is no longer a modeler parameter: radius tables are a "
+                          "sensor calibration file now (calibrate_diameters; "
+                          "tree_model --calibration, ~calibration_file)");
+        }
+        const auto it = setters().find(key);
+        if (it == setters().end())
+          return false;
+        it->second(config, v);
+        return true;
+      });
   config.validate();
   return config;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
@@ -290,10 +292,77 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   return std::move(tracks[chosen]);
 }
 
+/// How far outside a calibration's covered radii and noise a tree may go before the model says
+/// the tables were held constant there: a rod's or a section's neighbourhood.
+constexpr double COVERAGE_RADIUS_SLACK = 0.15;
+constexpr double COVERAGE_NOISE_SLACK = 0.25;
+
+std::string outsideRange(const char* what, const std::vector<double>& radii, double lo, double hi) {
+  int below = 0, above = 0;
+  for (const double r : radii) {
+    below += r < lo * (1.0 - COVERAGE_RADIUS_SLACK);
+    above += r > hi * (1.0 + COVERAGE_RADIUS_SLACK);
+  }
+  if (below + above == 0)
+    return "";
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "%d %s radii below and %d above the %.1f-%.1f mm the calibration covers: its "
+                "footprint table is held constant there",
+                below, what, above, 1000 * lo, 1000 * hi);
+  return text;
+}
+
+/// Which calibration the diameters went through, and where the tree needed it beyond its rig.
+DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
+                                      double sigma) {
+  DiameterCorrection d;
+  d.noise_sigma = sigma;
+  if (!config.ours_correct_noise_bias)
+    return d;
+  const SensorCalibration& cal = config.calibration;
+  if (!cal.given()) {
+    d.warnings.push_back(
+        "no sensor calibration: radii corrected for range noise only, not for the beam "
+        "footprint (make one with calibrate_diameters from a scan of a reference rig)");
+    return d;
+  }
+  d.calibration = cal.name;
+  d.calibration_hash = cal.hash;
+  const CalibrationCoverage& c = cal.coverage;
+  if (sigma < c.noise_min_m * (1.0 - COVERAGE_NOISE_SLACK) ||
+      sigma > c.noise_max_m * (1.0 + COVERAGE_NOISE_SLACK)) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "estimated range noise %.1f mm is outside the %.1f-%.1f mm the calibration "
+                  "covers: its footprint table is held constant there",
+                  1000 * sigma, 1000 * c.noise_min_m, 1000 * c.noise_max_m);
+    d.warnings.emplace_back(text);
+  }
+  std::vector<double> trunk, branches;
+  for (const auto& t : model.trunk)
+    trunk.push_back(0.5 * t.diameter);
+  for (const auto& b : model.primary_branches)
+    branches.push_back(0.5 * b.cylinder.diameter);
+  for (const auto& w :
+       {outsideRange("trunk", trunk, c.trunk_radius_min_m, c.trunk_radius_max_m),
+        outsideRange("branch", branches, c.branch_radius_min_m, c.branch_radius_max_m)}) {
+    if (!w.empty())
+      d.warnings.push_back(w);
+  }
+  return d;
+}
+
 }  // namespace
 
 TreeModeler::TreeModeler(const ModelerConfig& config) : config_(config) {
   config_.validate();
+  if (config_.ours_correct_noise_bias) {
+    config_.trunk_calibration =
+        addFootprint(trunkNoiseBias(config_), config_.calibration.trunk_footprint);
+    config_.branch_calibration =
+        addFootprint(branchNoiseBias(config_), config_.calibration.branch_footprint);
+  }
 }
 
 ModelResult TreeModeler::model(const Cloud& cloud) const {
@@ -467,6 +536,7 @@ ModelResult TreeModeler::model(const Points& input) const {
     for (const int k : f.inliers)
       result.classes[k] = PointClass::PRIMARY;
   }
+  model.correction = describeCorrection(config_, model, trunk.noise_sigma);
   model.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -41,6 +41,48 @@ struct SliceBounds {
   double max_distance = 1e300;
 };
 
+}  // namespace
+
+std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const CircleRansacOptions& o,
+                                              bool surface, double min_radius, double max_radius) {
+  std::vector<int> inliers;
+  auto circle = ransacCircle(plane, o, &inliers);
+  if (!circle)
+    return std::nullopt;
+  if (o.threshold / 2.5 > 0.2 * circle->radius) {
+    // Noise comparable to the radius: the circle band covers the whole disc and its centre
+    // drifts towards branch bases; the disc's trimmed mean is the better centre.
+    Eigen::Vector2d centre = circle->center;
+    const double window = circle->radius + o.threshold;
+    for (int round = 0; round < 4; ++round) {
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      int n_in = 0;
+      for (const auto& q : plane) {
+        if ((q - centre).norm() < window) {
+          sum += q;
+          ++n_in;
+        }
+      }
+      if (n_in == 0)
+        break;
+      centre = sum / n_in;
+    }
+    circle->center = centre;
+  }
+  SliceCircle out{*circle, static_cast<int>(inliers.size()), false};
+  if (surface) {
+    // The surface under the branch bases: the mode of the distances from the centre.
+    if (const auto mode =
+            surfaceCircle(plane, *circle, o.threshold / 2.5, min_radius, max_radius)) {
+      out.circle = *mode;
+      out.surface = true;
+    }
+  }
+  return out;
+}
+
+namespace {
+
 /// RANSAC circles of every slice along the centreline. With calibrate_at (the range noise), each
 /// slice's corrected radius goes through the trunk calibration; without, it is the radius.
 std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
@@ -91,47 +133,19 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     }
 
     o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
-    std::vector<int> inliers;
-    auto circle = ransacCircle(plane, o, &inliers);
-    sl.outliers = sl.points - static_cast<int>(inliers.size());
+    const auto measured = measureSliceCircle(plane, o, config.ours_correct_noise_bias,
+                                             bounds.min_radius, bounds.max_radius);
+    sl.outliers = sl.points - (measured ? measured->inliers : 0);
     sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
-    if (circle && threshold / 2.5 > 0.2 * circle->radius) {
-      // Noise comparable to the radius: the circle band covers the whole disc and its centre
-      // drifts towards branch bases; the disc's trimmed mean is the better centre.
-      Eigen::Vector2d centre = circle->center;
-      const double window = circle->radius + threshold;
-      for (int round = 0; round < 4; ++round) {
-        Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-        int n_in = 0;
-        for (const auto& q : plane) {
-          if ((q - centre).norm() < window) {
-            sum += q;
-            ++n_in;
-          }
-        }
-        if (n_in == 0)
-          break;
-        centre = sum / n_in;
-      }
-      circle->center = centre;
-    }
-    if (circle && inliers.size() >= MIN_SLICE_POINTS / 2) {
+    if (measured && measured->inliers >= MIN_SLICE_POINTS / 2) {
       sl.has_circle = true;
-
-      sl.radius = circle->radius;
-      sl.center = origin + circle->center.x() * u + circle->center.y() * v;
+      sl.radius = measured->circle.radius;
+      sl.center = origin + measured->circle.center.x() * u + measured->circle.center.y() * v;
       sl.corrected_radius = sl.radius;
-      if (config.ours_correct_noise_bias) {
-        // The surface under the branch bases: the mode of the distances from the centre.
-        if (const auto surface = surfaceCircle(plane, *circle, threshold / 2.5, bounds.min_radius,
-                                               bounds.max_radius)) {
-          sl.radius = surface->radius;
-          sl.center = origin + surface->center.x() * u + surface->center.y() * v;
-          // The beam footprint's wings widen thin sections: the calibration takes them off.
-          sl.corrected_radius = calibrate_at ? config.trunk_calibration.correct(
-                                                   sl.radius, *calibrate_at, MIN_TRUNK_RADIUS)
-                                             : sl.radius;
-        }
+      // The beam footprint's wings and the noise widen thin sections: the tables take them off.
+      if (measured->surface && calibrate_at) {
+        sl.corrected_radius =
+            config.trunk_calibration.correct(sl.radius, *calibrate_at, MIN_TRUNK_RADIUS);
       }
     }
   });

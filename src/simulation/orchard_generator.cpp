@@ -6,6 +6,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/simulation/calibration_rig.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {
@@ -16,6 +17,11 @@ Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed) {
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "orchard spacing: need 0 < neighbour_spacing_min <= neighbour_spacing_max and "
                 "row_spacing > 1 m");
+  }
+  if (config.preset == CALIBRATION_RIG_PRESET) {
+    Orchard rig = calibrationRig(seed);
+    rig.scene.has_ground = config.ground;
+    return rig;
   }
   const TreeParams params = presetParams(config.preset);
   Rng rng = Rng::derive(seed, 1);

@@ -1,113 +1,102 @@
-// calibrate_diameters: the trunk radius calibration of the modeler, from reference poles
-// scanned with the LMS111 model and the view plan. Prints the YAML keys for
-// config/tree_modeler.yaml and the samples behind them.
+// calibrate_diameters: a scanner's footprint calibration from scans of a reference rig of known
+// diameters (RIG.json: the truth schema, the pipe as trunk, the rods as primary branches).
 #include <boost/program_options.hpp>
 #include <cstdio>
 #include <iostream>
-#include <sstream>
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/evaluation/rig_calibration.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
-#include "dormant_tree_modeling/simulation/branch_calibration.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
 namespace {
 
-std::vector<double> parseList(const std::string& text, double scale) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) {
-    std::size_t used = 0;
-    const double v = std::stod(item, &used);
-    if (used != item.size())
-      throw po::error("not a number: '" + item + "'");
-    out.push_back(v * scale);
-  }
-  return out;
+/// A rig scan in double precision, the file's offset put back: the rig file is in the
+/// scan's own (maybe survey) coordinates.
+evaluation::RigScan readRigScan(const std::string& cloud_path, const std::string& rig_path) {
+  evaluation::RigScan scan;
+  scan.name = cloud_path;
+  scan.rig = io::readTruthFile(rig_path);
+  scan.points = io::readPointsInFileFrame(cloud_path);
+  return scan;
 }
 
-void printSamples(const char* what, const simulation::TrunkCalibrationResult& result) {
-  std::cerr << what << ":\n  radius mm  sensor noise mm  apparent mm  bias mm  noise estimate mm\n";
+void printSamples(const evaluation::RigCalibrationResult& result) {
+  std::cerr
+      << "part     id  true r mm  apparent mm  noise est mm  noise part mm  footprint mm  scan\n";
   for (const auto& s : result.samples) {
-    char line[160];
-    std::snprintf(line, sizeof(line), "  %9.1f  %15.1f  %11.2f  %+7.2f  %17.2f\n", 1000 * s.radius,
-                  1000 * s.sensor_noise, 1000 * s.apparent, 1000 * (s.apparent - s.radius),
-                  1000 * s.noise_estimate);
+    char line[256];
+    std::snprintf(line, sizeof(line), "%-7s %3d  %9.2f  %11.2f  %12.2f  %13.2f  %+12.2f  %s\n",
+                  s.trunk ? "section" : "rod", s.index, 1000 * s.radius, 1000 * s.apparent,
+                  1000 * s.noise, 1000 * s.noise_part, 1000 * s.footprint(), s.scan.c_str());
     std::cerr << line;
   }
-}
-
-std::string yamlList(const std::vector<double>& v) {
-  std::string s = "[";
-  char buf[32];
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof(buf), "%s%.5f", i ? ", " : "", v[i]);
-    s += buf;
-  }
-  return s + "]";
+  const auto& c = result.calibration.coverage;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "covers: trunk radius %.1f-%.1f mm, branch radius %.1f-%.1f mm, estimated noise "
+                "%.2f-%.2f mm\n",
+                1000 * c.trunk_radius_min_m, 1000 * c.trunk_radius_max_m,
+                1000 * c.branch_radius_min_m, 1000 * c.branch_radius_max_m, 1000 * c.noise_min_m,
+                1000 * c.noise_max_m);
+  std::cerr << line;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  simulation::TrunkCalibrationOptions opt;
-  std::string radii_mm = "5,7.5,10,15,20,30,45,70,100",
-              branch_radii_mm = "3,4,5,6.5,8,10,12.5,15,20", noise_mm = "3,6,12", params, output,
-              only;
+  std::vector<std::string> scans, rigs;
+  std::string output, params, name = "rig_calibration";
+  evaluation::RigSearch search;
   po::options_description desc(
-      "Usage: calibrate_diameters [--radii-mm LIST] [--branch-radii-mm LIST] [--noise-mm LIST] "
-      "[--only trunk|branch] [--params FILE] [--output FILE]\n"
-      "Scans reference poles (trunk) and a reference tree of rods (branches) with the LMS111 "
-      "model and the 40-view plan, measures them with the modeler and prints the "
-      "trunk_calibration_* and branch_calibration_* keys of config/tree_modeler.yaml");
-  desc.add_options()("help,h", "this help")(
-      "radii-mm", po::value(&radii_mm)->default_value(radii_mm), "pole radii, mm, ascending")(
-      "branch-radii-mm", po::value(&branch_radii_mm)->default_value(branch_radii_mm),
-      "rod radii, mm, ascending")("only", po::value(&only), "trunk or branch: one table only")(
-      "noise-mm", po::value(&noise_mm)->default_value(noise_mm),
-      "range noise levels, mm, ascending")("params,p", po::value(&params),
-                                           "modeler parameters, YAML (its trunk step settings)")(
-      "output,o", po::value(&output), "also write the keys to this file")(
-      "threads", po::value(&opt.threads)->default_value(0), "worker threads, 0 = all cores");
+      "Usage: calibrate_diameters --scan CLOUD --truth RIG.json [--scan CLOUD --truth RIG.json "
+      "...] --output calibration.yaml [--name NAME] [--params FILE]\n"
+      "Finds the pipe sections and rods of a reference rig in each scan, measures them with the "
+      "modeler's own estimators and noise estimate, takes off what range noise explains and "
+      "writes the rest (the beam footprint's widening) as a calibration file for "
+      "tree_model --calibration and the tree_modeler node's ~calibration_file");
+  desc.add_options()("help,h", "this help")("scan", po::value(&scans)->composing(),
+                                            "a scan of the rig (.pcd, .ply, x y z text)")(
+      "truth", po::value(&rigs)->composing(),
+      "the rig of the --scan before it (truth schema: pipe as trunk, rods as primary_branches; "
+      "diameters exact, axes within a few cm, in the scan's frame)")("output,o", po::value(&output),
+                                                                     "calibration file to write")(
+      "name", po::value(&name)->default_value(name), "the calibration's name (in every model)")(
+      "params,p", po::value(&params), "modeler parameters, YAML (the ones the trees will use)")(
+      "axis-tolerance-m",
+      po::value(&search.axis_tolerance_m)->default_value(search.axis_tolerance_m),
+      "how far a rod or section may lie from its axis in the rig file (m)");
   try {
     po::variables_map vm;
     if (tools::parseOrHelp(argc, argv, desc, vm))
       return 0;
-    if (!only.empty() && only != "trunk" && only != "branch")
-      throw po::error("--only takes trunk or branch");
-    opt.noise = parseList(noise_mm, 1e-3);
-    if (!params.empty())
-      opt.modeler = modeling::loadModelerConfig(params);
-    std::string yaml = "  # calibrate_diameters --radii-mm " + radii_mm + " --branch-radii-mm " +
-                       branch_radii_mm + " --noise-mm " + noise_mm + "\n";
-    auto append = [&](const std::string& key, const modeling::RadiusCalibration& c) {
-      yaml += "  " + key + "_radii: " + yamlList(c.radii) + "\n  " + key +
-              "_noise: " + yamlList(c.noise) + "\n  " + key + "_bias: " + yamlList(c.bias) + "\n";
-    };
-    if (only != "branch") {
-      opt.radii = parseList(radii_mm, 1e-3);
-      const auto trunk = simulation::calibrateTrunkRadii(opt);
-      printSamples("trunk", trunk);
-      append("trunk_calibration", trunk.calibration);
-    }
-    if (only != "trunk") {
-      opt.radii = parseList(branch_radii_mm, 1e-3);
-      const auto branch = simulation::calibrateBranchRadii(opt);
-      printSamples("branch", branch);
-      append("branch_calibration", branch.calibration);
-    }
-    std::cout << yaml;
-    if (!output.empty())
-      io::writeTextFile(output, yaml);
+    if (scans.empty() || scans.size() != rigs.size() || output.empty())
+      throw po::error("give --output and one --truth for each --scan");
+    if (!(search.axis_tolerance_m > 0.0 && search.axis_tolerance_m <= 0.5))
+      throw po::error("--axis-tolerance-m must be in (0, 0.5]");
+    const modeling::ModelerConfig config =
+        params.empty() ? modeling::ModelerConfig{} : modeling::loadModelerConfig(params);
+    std::vector<evaluation::RigScan> rig_scans;
+    for (std::size_t i = 0; i < scans.size(); ++i)
+      rig_scans.push_back(readRigScan(scans[i], rigs[i]));
+    const auto result = evaluation::calibrateFromRig(rig_scans, config, name, search);
+    printSamples(result);
+    for (const auto& w : result.warnings)
+      std::cerr << "calibrate_diameters: warning: " << w << "\n";
+    std::string comment = "Sensor calibration made by calibrate_diameters from:";
+    for (std::size_t i = 0; i < scans.size(); ++i)
+      comment += "\n  --scan " + scans[i] + " --truth " + rigs[i];
+    io::writeTextFile(output, modeling::sensorCalibrationToYaml(result.calibration, comment));
+    std::cout << "calibrate_diameters: " << result.samples.size() << " parts measured in "
+              << scans.size() << " scan(s), " << result.warnings.size() << " warning(s) -> "
+              << output << "\n";
     return 0;
   } catch (const po::error& e) {
-    std::cerr << "calibrate_diameters: " << e.what() << "\n";
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "calibrate_diameters: not a number in a list\n";
+    std::cerr << "calibrate_diameters: " << e.what() << "\n" << desc << "\n";
     return 2;
   } catch (const Error& e) {
     std::cerr << "calibrate_diameters: " << errorCodeName(e.code()) << ": " << e.what() << "\n";

@@ -38,15 +38,18 @@ int exitCode(ErrorCode code) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string input, output, params, csv, picture;
+  std::string input, output, params, csv, picture, calibration;
   po::options_description desc(
       "Usage: tree_model INPUT --output model.json [--params FILE] [--csv FILE] [--picture PNG] "
-      "[--paper]\n"
+      "[--calibration FILE] [--paper]\n"
       "Models the trunk and primary branches of the tree in INPUT (.pcd, .ply, or x y z text)");
   desc.add_options()("help,h", "this help")("input", po::value(&input), "input cloud")(
       "output,o", po::value(&output), "model JSON to write (docs/evaluation.md)")(
       "params,p", po::value(&params), "modeler parameters, YAML (config/tree_modeler.yaml)")(
-      "csv", po::value(&csv), "also write the cylinders as CSV")(
+      "calibration,c", po::value(&calibration),
+      "the scanner's diameter calibration (calibrate_diameters; config/calibration/). Without "
+      "one, radii are corrected for range noise only")("csv", po::value(&csv),
+                                                       "also write the cylinders as CSV")(
       "picture", po::value(&picture), "also render the cylinders over the cloud (front view, PNG)")(
       "paper", "the paper's method only (every improvement switched off), for comparisons")(
       "verbose,v", "print stage timings and diagnostics to stderr");
@@ -64,6 +67,8 @@ int main(int argc, char** argv) {
         vm.count("paper") ? modeling::ModelerConfig::paper() : modeling::ModelerConfig{};
     if (!params.empty())
       config = modeling::loadModelerConfig(params);
+    if (!calibration.empty())
+      config.calibration = modeling::loadSensorCalibration(calibration);
     const modeling::TreeModeler modeler(config);
     const auto cloud = io::readCloud(input);
     if (cloud.dropped_non_finite > 0) {
@@ -74,6 +79,8 @@ int main(int argc, char** argv) {
       std::cerr << "tree_model: dropped " << result.preprocess.far_outliers
                 << " stray points far outside the cloud's bulk\n";
     }
+    for (const auto& w : result.model.correction.warnings)
+      std::cerr << "tree_model: warning: " << w << "\n";
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));
     if (!csv.empty())
       io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));

@@ -7,7 +7,6 @@
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/radius_calibration.h"
-#include "dormant_tree_modeling/simulation/branch_calibration.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -62,8 +61,8 @@ TEST(RadiusCalibration, ConfigRejectsInconsistentTables) {
   config.trunk_calibration.bias[0] = 0.2;
   EXPECT_THROW(config.validate(), Error);
   config.trunk_calibration = {};
-  EXPECT_NO_THROW(config.validate());  // no table: no correction
-  EXPECT_TRUE(ModelerConfig{}.trunk_calibration.valid());
+  EXPECT_NO_THROW(config.validate());                       // no table: no correction
+  EXPECT_FALSE(ModelerConfig{}.trunk_calibration.valid());  // TreeModeler fills it
 }
 
 TEST(SurfaceCircle, IgnoresABranchBaseThatPullsLeastSquaresOutwards) {
@@ -94,48 +93,6 @@ TEST(SurfaceCircle, IgnoresABranchBaseThatPullsLeastSquaresOutwards) {
   EXPECT_LT(s->center.norm(), 0.0015);
   EXPECT_FALSE(surfaceCircle({{0, 0}, {1, 0}}, *ls, 0.003, 0.01, 0.08));
   EXPECT_FALSE(surfaceCircle(pts, *ls, 0.003, 0.08, 0.01));
-}
-
-TEST(TrunkCalibration, ThinPolesLookWiderThanThickOnes) {
-  // Two reference poles through a reduced plan (one platform position): the footprint wings
-  // widen the thin pole by more than the thick one, and the table holds what was measured.
-  simulation::TrunkCalibrationOptions o;
-  o.radii = {0.01, 0.05};
-  o.noise = {0.003};
-  o.plan.heights = {1.5};
-  o.plan.positions_per_height = 1;
-  o.plan.slide_steps = 2;
-  const auto result = simulation::calibrateTrunkRadii(o);
-  ASSERT_TRUE(result.calibration.valid());
-  ASSERT_EQ(result.calibration.bias.size(), 2u);
-  EXPECT_GT(result.calibration.bias[0], result.calibration.bias[1] + 0.001);
-  EXPECT_GT(result.calibration.bias[0], 0.0);
-  EXPECT_LT(result.calibration.bias[0], 0.012);  // at most about a beam radius
-  EXPECT_LT(std::abs(result.calibration.bias[1]), 0.004);
-  o.radii = {0.05, 0.01};
-  EXPECT_THROW(simulation::calibrateTrunkRadii(o), Error);
-}
-
-TEST(BranchCalibration, ThinRodsLookWiderAndTheTableIsMonotone) {
-  // The reference tree through a reduced plan: every rod is found; a thin rod's apparent
-  // (RMS) radius carries the footprint and noise, so exceeds its true radius by more than a
-  // thick rod's does, and the apparent radius still grows with the true one (invertible).
-  simulation::TrunkCalibrationOptions o;
-  o.radii = {0.004, 0.015};
-  o.noise = {0.006};
-  o.plan.heights = {1.5};
-  o.plan.slide_steps = 2;
-  const auto result = simulation::calibrateBranchRadii(o);
-  ASSERT_EQ(result.samples.size(), 2u);
-  const auto& thin = result.samples[0];
-  const auto& thick = result.samples[1];
-  EXPECT_GT(thin.apparent - thin.radius, thick.apparent - thick.radius);
-  EXPECT_GT(thin.apparent, thin.radius);
-  EXPECT_GT(thick.apparent, thin.apparent);
-  EXPECT_GT(thin.noise_estimate, 0.0);
-  const auto& c = result.calibration;
-  ASSERT_TRUE(c.valid());
-  EXPECT_NEAR(c.correct(thick.apparent, thick.noise_estimate, 0.002), 0.015, 1e-6);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "dormant_tree_modeling/common/cloud.h"
 
@@ -46,6 +47,10 @@ struct CloudReadResult {
 /// @throws Error FILE_NOT_FOUND, UNKNOWN_FORMAT, PARSE_ERROR (with line number for text),
 ///         EMPTY_INPUT (no finite point, unless options.allow_empty)
 CloudReadResult readCloud(const std::string& path, const CloudReadOptions& options = {});
+
+/// @brief readCloud's points in double precision in the file's own frame (the offset put
+/// back), for comparing with positions given in that frame (survey coordinates included).
+std::vector<Eigen::Vector3d> readPointsInFileFrame(const std::string& path);
 
 /// @brief Write a cloud as binary PCD, binary PLY or XYZ text, chosen by the extension.
 /// @param path output file; its directory must exist

@@ -4,15 +4,10 @@
 #include <string>
 
 #include "dormant_tree_modeling/modeling/radius_calibration.h"
+#include "dormant_tree_modeling/modeling/sensor_calibration.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
-
-/// @brief The trunk radius calibration shipped in config/tree_modeler.yaml.
-RadiusCalibration defaultTrunkCalibration();
-
-/// @brief The branch radius calibration shipped in config/tree_modeler.yaml.
-RadiusCalibration defaultBranchCalibration();
 
 /// @brief Every parameter of the tree modeler. Defaults are the paper's values (Medeiros et
 /// al., docs/algorithms.md) where the paper tuned one; the `ours_*` switches turn on what we
@@ -57,17 +52,18 @@ struct ModelerConfig {
   /// working range (8 mm + 15 mrad, SICK LMS1xx manual 3.6.2), calibrated on the sensor model;
   /// re-calibrate against calipers in the field, 0 for an ideal beam.
   double beam_spread = 0.012;
-  /// Trunk radius calibration (apparent minus true radius over true radius and estimated
-  /// noise), applied to every trunk slice when ours_correct_noise_bias is on. YAML keys
-  /// trunk_calibration_radii, trunk_calibration_noise, trunk_calibration_bias (m); empty lists:
-  /// no correction. Default: made by `calibrate_diameters` on the LMS111 model with the
-  /// paper's 40-view plan (config/tree_modeler.yaml); re-make it from field references.
-  RadiusCalibration trunk_calibration = defaultTrunkCalibration();
-  /// Branch radius calibration: the apparent radius is the RMS distance of a branch's points
-  /// from its axis (footprint and noise dominate it on thin branches); the table maps it to
-  /// the true radius. YAML keys branch_calibration_radii, _noise, _bias (m); empty lists: the
-  /// moment less beam_spread and noise in quadrature instead. Made by `calibrate_diameters`.
-  RadiusCalibration branch_calibration = defaultBranchCalibration();
+  /// The scanner's footprint calibration (calibrate_diameters; loaded from a file by the tools
+  /// and the node, not a key of the parameter YAML). Empty (the default): radii are corrected
+  /// for range noise alone and the model says so.
+  SensorCalibration calibration;
+  /// The radius bias the trunk step takes off each slice (apparent minus true, over true radius
+  /// and estimated noise): TreeModeler sets it to the noise part (trunkNoiseBias) plus the
+  /// calibration's trunk footprint when ours_correct_noise_bias is on. Set by hand only when
+  /// calling the stages directly; empty: raw radii.
+  RadiusCalibration trunk_calibration;
+  /// The same for the branch step's raw RMS radius (branchNoiseBias plus the branch
+  /// footprint); empty: the moment less beam_spread and noise in quadrature instead.
+  RadiusCalibration branch_calibration;
   /// Diagnostic: report branches' raw RMS radius, uncorrected (what calibrate_diameters
   /// measures to build branch_calibration).
   bool branch_raw_radius = false;

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 namespace dormant_tree_modeling {
@@ -35,12 +36,23 @@ struct PrimaryBranch {
   BranchMeasurement measurement;
 };
 
+/// @brief How the model's diameters were corrected for the scanner.
+struct DiameterCorrection {
+  std::string calibration;       ///< the sensor calibration's name; empty: none was given
+  std::string calibration_hash;  ///< of its file (SensorCalibration::hash)
+  double noise_sigma = 0.0;      ///< m, the range noise the modeler estimated (or was given)
+  /// Each said once: no calibration (noise part only), or the tree needing the tables outside
+  /// the radii or noise the calibration's rig covered.
+  std::vector<std::string> warnings;
+};
+
 /// @brief The model of one tree (docs/evaluation.md "model.json").
 struct TreeModel {
   std::size_t input_points = 0;
   std::vector<CylinderModel> trunk;  ///< bottom to top
   std::vector<PrimaryBranch> primary_branches;
   double runtime_s = 0.0;  ///< wall time of the modeler, s
+  DiameterCorrection correction;
 };
 
 /// @brief The model in another frame: centres moved, axes rotated by `pose` (a rigid

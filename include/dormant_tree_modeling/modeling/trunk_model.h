@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
@@ -77,6 +78,22 @@ struct TrunkModel {
   /// without cylinders.
   double diameterAt(double s) const;
 };
+
+/// @brief One slice's circle as the trunk step measures it.
+struct SliceCircle {
+  Circle circle;         ///< in the slice plane
+  int inliers = 0;       ///< of the RANSAC circle
+  bool surface = false;  ///< the radius is the surface mode (surfaceCircle), not RANSAC's
+};
+
+/// @brief The trunk step's estimator of one cross-section: a RANSAC circle; its centre from the
+/// disc's trimmed mean where the band (options.threshold) exceeds a fifth of the radius; with
+/// `surface`, the mode circle of the surface (surfaceCircle, bandwidth threshold / 2.5) within
+/// [min_radius, max_radius]. The noise model (noise_bias.h) runs this very estimator.
+/// @return nothing when RANSAC finds no circle
+std::optional<SliceCircle> measureSliceCircle(const Points2& plane,
+                                              const CircleRansacOptions& options, bool surface,
+                                              double min_radius, double max_radius);
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
 /// parts: 1.4826 MAD of the radial residuals, x sqrt(3/2) because a return's radial residual

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/evaluation/ground_truth.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/sensor_calibration.h"
+
+namespace dormant_tree_modeling {
+namespace evaluation {
+
+/// @brief One scan of the reference rig and what is known of it (RIG.json, the truth schema of
+/// docs/evaluation.md: the pipe as `trunk`, constant-diameter sections between pairs of
+/// points; the rods as `primary_branches`). Diameters exact, axes within a few cm, in the
+/// scan's frame (survey coordinates too).
+struct RigScan {
+  std::string name;  ///< for messages and the calibration's sources
+  modeling::Points points;
+  GroundTruth rig;
+};
+
+/// @brief One measured pipe section or rod.
+struct RigSample {
+  std::string scan;
+  bool trunk = false;       ///< pipe section (trunk step), else rod (branch step)
+  int index = 0;            ///< section number from the bottom, or rod id
+  double radius = 0.0;      ///< true (m)
+  double apparent = 0.0;    ///< the modeler's raw radius (m)
+  double noise = 0.0;       ///< the modeler's noise estimate on that scan (m)
+  double noise_part = 0.0;  ///< what the noise alone explains (m)
+  /// apparent - radius - noise_part: the footprint's share (m)
+  double footprint() const { return apparent - radius - noise_part; }
+};
+
+/// @brief A calibration and how it was made.
+struct RigCalibrationResult {
+  modeling::SensorCalibration calibration;
+  std::vector<RigSample> samples;
+  std::vector<std::string> warnings;  ///< rods or sections not found, narrow coverage
+};
+
+/// @brief How the rig's parts are searched for around the axes RIG.json gives.
+struct RigSearch {
+  double axis_tolerance_m = 0.08;  ///< a rod or section this far from its stated axis is found
+  double section_margin_m = 0.06;  ///< left out at each end of a pipe section (steps, rods)
+  int min_slices = 3;              ///< slice circles a section needs to be measured
+};
+
+/// @brief Measure every rod and pipe section of the rig in each scan with the modeler's own
+/// estimators (the trunk step's slice circles, the branch step's raw radius) and its noise
+/// estimate, take off the noise part (noise_bias.h) and tabulate the rest, the footprint, over
+/// the true radius: one row per scan's noise, monotone (non-increasing) in the radius.
+/// @param config the modeler's parameters (its calibration is ignored)
+/// @param name the calibration's name
+/// @throws Error EMPTY_INPUT for a scan without points, NO_TRUNK when a scan shows no pipe
+///         section or no rod of its rig, INVALID_ARGUMENT for a rig without sections or rods
+RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
+                                      const modeling::ModelerConfig& config,
+                                      const std::string& name, const RigSearch& search = {});
+
+}  // namespace evaluation
+}  // namespace dormant_tree_modeling

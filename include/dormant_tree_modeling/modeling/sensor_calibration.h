@@ -1,0 +1,52 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/modeling/radius_calibration.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief What a calibration was measured on: the true radii of the rig's pipe sections and
+/// rods, and the noise the modeler estimated on its scans (m). Outside it a table is held
+/// constant, which the modeler reports.
+struct CalibrationCoverage {
+  double trunk_radius_min_m = 0.0, trunk_radius_max_m = 0.0;
+  double branch_radius_min_m = 0.0, branch_radius_max_m = 0.0;
+  double noise_min_m = 0.0, noise_max_m = 0.0;
+};
+
+/// @brief The part of one scanner's radius bias that range noise does not explain: the beam
+/// footprint's widening of thin objects (apparent minus true radius, m, over the true radius
+/// and the estimated noise, after the noise part of noise_bias.h is taken off). Made by
+/// `calibrate_diameters` from scans of a rig of known diameters; loaded by
+/// `tree_model --calibration` and the tree_modeler node's `~calibration_file`.
+struct SensorCalibration {
+  std::string name;  ///< empty: no calibration (the noise part alone is corrected)
+  std::string hash;  ///< FNV-1a 64 of the file's bytes, 16 hex digits: which file it was
+  RadiusCalibration trunk_footprint;   ///< of the trunk step's slice radius
+  RadiusCalibration branch_footprint;  ///< of the branch step's raw radius
+  CalibrationCoverage coverage;
+  std::vector<std::string> sources;  ///< the scans it was made from, for the record
+
+  /// @brief Whether a calibration is set.
+  bool given() const { return !name.empty(); }
+};
+
+/// @brief FNV-1a 64 of bytes, as 16 lower-case hex digits.
+std::string fnv1aHex(const std::string& bytes);
+
+/// @brief Read a calibration file (YAML, top-level key `sensor_calibration`).
+/// @throws Error FILE_NOT_FOUND, PARSE_ERROR (malformed YAML, a missing or unknown key, a value
+///         of the wrong type), INVALID_ARGUMENT (tables not ascending, sizes that disagree,
+///         a bias beyond +/-50 mm), each naming the file and the key
+SensorCalibration loadSensorCalibration(const std::string& path);
+
+/// @brief The file text of a calibration (what loadSensorCalibration reads back), with
+/// `comment` (lines) at the top. The hash is not part of the text.
+std::string sensorCalibrationToYaml(const SensorCalibration& calibration,
+                                    const std::string& comment);
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

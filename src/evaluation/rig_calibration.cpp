@@ -1,0 +1,353 @@
+#include "dormant_tree_modeling/evaluation/rig_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/statistics.h"
+#include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/modeling/noise_bias.h"
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+
+namespace dormant_tree_modeling {
+namespace evaluation {
+
+namespace {
+
+constexpr double SAME_DIAMETER_M = 1e-6;
+constexpr double SAME_NOISE_M = 2e-4;  // scans whose noise estimates differ less share a row
+constexpr double MAX_ROD_ANGLE_DEG = 30.0;
+constexpr double MAX_ROD_ARC_M = 1.0;
+// A footprint this large is a mismatch (a rod found on the wrong part, a wrong diameter).
+constexpr double IMPLAUSIBLE_FOOTPRINT_M = 0.02;
+
+struct Section {
+  int index = 0;
+  Eigen::Vector3d a, b;  // its axis, the margins taken off
+  double radius = 0.0;
+};
+
+std::string mm(double m) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%.1f mm", 1000 * m);
+  return b;
+}
+
+/// The pipe's constant-diameter sections long enough to measure, margins taken off.
+std::vector<Section> pipeSections(const Polyline& pipe, const RigSearch& search,
+                                  double slice_height) {
+  std::vector<Section> out;
+  for (std::size_t k = 0; k + 1 < pipe.points.size() && k + 1 < pipe.diameters.size(); ++k) {
+    const Eigen::Vector3d a = pipe.points[k], b = pipe.points[k + 1];
+    const double len = (b - a).norm();
+    if (std::abs(pipe.diameters[k] - pipe.diameters[k + 1]) > SAME_DIAMETER_M ||
+        len < 2.0 * search.section_margin_m + search.min_slices * slice_height)
+      continue;
+    const Eigen::Vector3d d = (b - a) / len;
+    out.push_back({static_cast<int>(k), a + search.section_margin_m * d,
+                   b - search.section_margin_m * d, 0.5 * pipe.diameters[k]});
+  }
+  return out;
+}
+
+/// The modeler with raw radii: no footprint, no noise part, branch radii uncorrected.
+modeling::ModelerConfig rawConfig(modeling::ModelerConfig c) {
+  c.calibration = {};
+  c.ours_correct_noise_bias = true;
+  c.branch_raw_radius = true;
+  c.trunk_calibration = {};
+  c.branch_calibration = {};
+  return c;
+}
+
+/// The scan and its rig moved so that the pipe's foot is the origin: survey coordinates keep
+/// their millimetres through the modeler's float stages.
+void recentre(RigScan& scan) {
+  if (scan.rig.trunk.points.empty())
+    return;
+  const Eigen::Vector3d origin = scan.rig.trunk.points.front();
+  for (auto& p : scan.points)
+    p -= origin;
+  auto move = [&](Polyline& line) {
+    for (auto& p : line.points)
+      p -= origin;
+  };
+  move(scan.rig.trunk);
+  for (auto& b : scan.rig.primary_branches)
+    move(b);
+  for (auto& b : scan.rig.minor_branches)
+    move(b);
+}
+
+/// Every rod the whole modeler finds near its stated axis, its raw radius; sets the scan's
+/// noise estimate.
+std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerConfig& raw,
+                                   const RigSearch& search, double* sigma,
+                                   std::vector<std::string>* warnings) {
+  modeling::ModelResult result;
+  try {
+    result = modeling::TreeModeler(raw).model(scan.points);
+  } catch (const Error& e) {
+    throw Error(e.code() == ErrorCode::EMPTY_INPUT ? ErrorCode::EMPTY_INPUT : ErrorCode::NO_TRUNK,
+                "rig scan " + scan.name + ": " + e.what());
+  }
+  *sigma = result.noise_sigma;
+  MatchBounds bounds;
+  bounds.min_distance = search.axis_tolerance_m;
+  bounds.max_arc_length = MAX_ROD_ARC_M;
+  bounds.max_angle_deg = MAX_ROD_ANGLE_DEG;
+  const TreeScore score = evaluate(result.model, scan.rig, bounds);
+  std::vector<RigSample> out;
+  for (const auto& m : score.matches) {
+    RigSample s;
+    s.scan = scan.name;
+    s.index = scan.rig.primary_branches[m.truth].id;
+    s.radius = 0.5 * scan.rig.primary_branches[m.truth].diameters.front();
+    s.apparent = 0.5 * m.detected_diameter;
+    s.noise = *sigma;
+    out.push_back(s);
+  }
+  for (const int t : score.missed) {
+    const auto& rod = scan.rig.primary_branches[t];
+    warnings->push_back("rig scan " + scan.name + ": rod " + std::to_string(rod.id) + " (" +
+                        mm(rod.diameters.front()) + " diameter) not found within " +
+                        mm(search.axis_tolerance_m) + " of its axis in the rig file");
+  }
+  return out;
+}
+
+/// Every pipe section's raw radius: the median of the trunk step's slice circles along it.
+std::vector<RigSample> measureSections(const RigScan& scan, const modeling::ModelerConfig& raw,
+                                       const RigSearch& search, double sigma,
+                                       std::vector<std::string>* warnings) {
+  std::vector<RigSample> out;
+  for (const Section& sec : pipeSections(scan.rig.trunk, search, raw.slice_height)) {
+    const Eigen::Vector3d d = (sec.b - sec.a).normalized();
+    const double len = (sec.b - sec.a).norm(), reach = sec.radius + search.axis_tolerance_m;
+    std::vector<int> region;
+    for (std::size_t i = 0; i < scan.points.size(); ++i) {
+      const Eigen::Vector3d w = scan.points[i] - sec.a;
+      const double t = w.dot(d);
+      if (t >= 0.0 && t <= len && (w - t * d).norm() <= reach)
+        region.push_back(static_cast<int>(i));
+    }
+    std::vector<double> radii;
+    try {
+      const auto trunk = modeling::modelTrunk(scan.points, region, {sec.a, sec.b}, sec.radius, raw);
+      for (const auto& sl : trunk.slices) {
+        const double t = (sl.center - sec.a).dot(d);
+        if (sl.has_circle && t >= 0.0 && t <= len)
+          radii.push_back(sl.radius);
+      }
+    } catch (const Error&) {
+      // Reported below as not measured.
+    }
+    if (static_cast<int>(radii.size()) < search.min_slices) {
+      warnings->push_back("rig scan " + scan.name + ": pipe section " + std::to_string(sec.index) +
+                          " (" + mm(2 * sec.radius) +
+                          " diameter) not measured: " + std::to_string(radii.size()) +
+                          " slice circles within " + mm(search.axis_tolerance_m) + " of its axis");
+      continue;
+    }
+    RigSample s;
+    s.scan = scan.name;
+    s.trunk = true;
+    s.index = sec.index;
+    s.radius = sec.radius;
+    s.apparent = median(radii);
+    s.noise = sigma;
+    out.push_back(s);
+  }
+  return out;
+}
+
+/// Pool-adjacent-violators: the least-squares non-increasing sequence.
+std::vector<double> nonIncreasing(const std::vector<double>& v, const std::vector<double>& w) {
+  std::vector<double> value, weight;
+  std::vector<int> size;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    value.push_back(v[i]);
+    weight.push_back(w[i]);
+    size.push_back(1);
+    while (value.size() > 1 && value[value.size() - 2] < value.back()) {
+      const std::size_t j = value.size() - 2;
+      value[j] =
+          (value[j] * weight[j] + value.back() * weight.back()) / (weight[j] + weight.back());
+      weight[j] += weight.back();
+      size[j] += size.back();
+      value.pop_back();
+      weight.pop_back();
+      size.pop_back();
+    }
+  }
+  std::vector<double> out;
+  for (std::size_t j = 0; j < value.size(); ++j)
+    out.insert(out.end(), size[j], value[j]);
+  return out;
+}
+
+/// The noise rows: each scan's estimate, close ones merged.
+std::vector<double> noiseRows(const std::vector<double>& sigmas) {
+  std::vector<double> sorted = sigmas, rows;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<int> counts;
+  for (const double s : sorted) {
+    if (!rows.empty() && s - rows.back() < SAME_NOISE_M) {
+      rows.back() = (rows.back() * counts.back() + s) / (counts.back() + 1);
+      ++counts.back();
+    } else {
+      rows.push_back(s);
+      counts.push_back(1);
+    }
+  }
+  return rows;
+}
+
+std::size_t rowOf(const std::vector<double>& rows, double sigma) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    if (std::abs(rows[k] - sigma) < std::abs(rows[best] - sigma))
+      best = k;
+  }
+  return best;
+}
+
+/// One row: the mean footprint per true radius, made non-increasing, then read at `radii`
+/// (linear between, held beyond).
+std::vector<double> footprintRow(const std::vector<const RigSample*>& samples,
+                                 const std::vector<double>& radii) {
+  std::map<double, std::pair<double, int>> by_radius;
+  for (const RigSample* s : samples) {
+    auto& e = by_radius[s->radius];
+    e.first += s->footprint();
+    ++e.second;
+  }
+  std::vector<double> r, v, w;
+  for (const auto& [radius, e] : by_radius) {
+    r.push_back(radius);
+    v.push_back(e.first / e.second);
+    w.push_back(e.second);
+  }
+  v = nonIncreasing(v, w);
+  std::vector<double> out;
+  for (const double x : radii) {
+    if (x <= r.front()) {
+      out.push_back(v.front());
+    } else if (x >= r.back()) {
+      out.push_back(v.back());
+    } else {
+      const std::size_t i = std::upper_bound(r.begin(), r.end(), x) - r.begin() - 1;
+      const double t = (x - r[i]) / (r[i + 1] - r[i]);
+      out.push_back((1.0 - t) * v[i] + t * v[i + 1]);
+    }
+  }
+  return out;
+}
+
+/// The footprint table of one part (trunk sections or rods) over all scans.
+modeling::RadiusCalibration footprintTable(const std::vector<RigSample>& samples, bool trunk,
+                                           const std::vector<double>& rows) {
+  modeling::RadiusCalibration t;
+  std::vector<std::vector<const RigSample*>> per_row(rows.size());
+  for (const auto& s : samples) {
+    if (s.trunk != trunk)
+      continue;
+    t.radii.push_back(s.radius);
+    per_row[rowOf(rows, s.noise)].push_back(&s);
+  }
+  std::sort(t.radii.begin(), t.radii.end());
+  t.radii.erase(std::unique(t.radii.begin(), t.radii.end()), t.radii.end());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (per_row[k].empty())
+      continue;  // this scan showed none of this part: the other rows hold
+    const auto row = footprintRow(per_row[k], t.radii);
+    t.noise.push_back(rows[k]);
+    t.bias.insert(t.bias.end(), row.begin(), row.end());
+  }
+  return t;
+}
+
+void checkCoverage(const std::vector<RigSample>& samples, bool trunk, const char* what,
+                   std::vector<std::string>* warnings, double* lo, double* hi) {
+  *lo = 1e300;
+  *hi = 0.0;
+  int implausible = 0;
+  for (const auto& s : samples) {
+    if (s.trunk != trunk)
+      continue;
+    *lo = std::min(*lo, s.radius);
+    *hi = std::max(*hi, s.radius);
+    implausible += std::abs(s.footprint()) > IMPLAUSIBLE_FOOTPRINT_M;
+  }
+  if (*hi <= 0.0) {
+    throw Error(ErrorCode::NO_TRUNK, std::string("no ") + what +
+                                         " of the rig was found in any scan: check the rig "
+                                         "file's axes against the scan's frame");
+  }
+  if (*hi - *lo < SAME_DIAMETER_M) {
+    warnings->push_back(std::string("the rig's ") + what + "s cover one diameter (" + mm(2 * *lo) +
+                        "): the footprint is taken as constant over radius; add other diameters");
+  }
+  if (implausible > 0) {
+    warnings->push_back(std::to_string(implausible) + " " + what +
+                        " measurements differ from their true radius by more than " +
+                        mm(IMPLAUSIBLE_FOOTPRINT_M) +
+                        " beyond what noise explains: check the rig file's diameters");
+  }
+}
+
+}  // namespace
+
+RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
+                                      const modeling::ModelerConfig& config,
+                                      const std::string& name, const RigSearch& search) {
+  if (scans.empty())
+    throw Error(ErrorCode::INVALID_ARGUMENT, "no rig scan given");
+  const modeling::ModelerConfig raw = rawConfig(config);
+  raw.validate();
+  const auto trunk_noise = modeling::trunkNoiseBias(raw);
+  const auto branch_noise = modeling::branchNoiseBias(raw);
+  RigCalibrationResult result;
+  std::vector<double> sigmas;
+  for (RigScan scan : scans) {
+    if (scan.points.empty())
+      throw Error(ErrorCode::EMPTY_INPUT, "rig scan " + scan.name + " has no points");
+    if (pipeSections(scan.rig.trunk, search, raw.slice_height).empty() ||
+        scan.rig.primary_branches.empty()) {
+      throw Error(ErrorCode::INVALID_ARGUMENT,
+                  "rig of " + scan.name +
+                      ": needs a pipe ('trunk') with at least one constant-diameter section and "
+                      "rods ('primary_branches')");
+    }
+    recentre(scan);
+    double sigma = 0.0;
+    auto rods = measureRods(scan, raw, search, &sigma, &result.warnings);
+    auto sections = measureSections(scan, raw, search, sigma, &result.warnings);
+    for (auto& s : rods)
+      s.noise_part = branch_noise.biasAt(s.radius, sigma);
+    for (auto& s : sections)
+      s.noise_part = trunk_noise.biasAt(s.radius, sigma);
+    result.samples.insert(result.samples.end(), sections.begin(), sections.end());
+    result.samples.insert(result.samples.end(), rods.begin(), rods.end());
+    sigmas.push_back(sigma);
+    result.calibration.sources.push_back(scan.name);
+  }
+  modeling::SensorCalibration& c = result.calibration;
+  c.name = name;
+  checkCoverage(result.samples, true, "pipe section", &result.warnings,
+                &c.coverage.trunk_radius_min_m, &c.coverage.trunk_radius_max_m);
+  checkCoverage(result.samples, false, "rod", &result.warnings, &c.coverage.branch_radius_min_m,
+                &c.coverage.branch_radius_max_m);
+  const auto rows = noiseRows(sigmas);
+  c.coverage.noise_min_m = rows.front();
+  c.coverage.noise_max_m = rows.back();
+  c.trunk_footprint = footprintTable(result.samples, true, rows);
+  c.branch_footprint = footprintTable(result.samples, false, rows);
+  return result;
+}
+
+}  // namespace evaluation
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,183 @@
+#include "dormant_tree_modeling/modeling/sensor_calibration.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "dormant_tree_modeling/common/error.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+constexpr const char* ROOT_KEY = "sensor_calibration";
+constexpr double MAX_ABS_BIAS_M = 0.05;
+constexpr double MAX_RADIUS_M = 1.0;
+constexpr double MAX_NOISE_M = 0.1;
+
+[[noreturn]] void fail(ErrorCode code, const std::string& path, const std::string& what) {
+  throw Error(code, "calibration file " + path + ": " + what);
+}
+
+/// The map under `key`, with only the `allowed` keys.
+YAML::Node section(const YAML::Node& parent, const std::string& key,
+                   const std::set<std::string>& allowed, const std::string& path) {
+  const YAML::Node n = parent[key];
+  if (!n || !n.IsMap())
+    fail(ErrorCode::PARSE_ERROR, path, "'" + key + "' is missing or not a map");
+  for (const auto& kv : n) {
+    const std::string k = kv.first.as<std::string>();
+    if (!allowed.count(k))
+      fail(ErrorCode::PARSE_ERROR, path, "unknown key '" + key + "." + k + "'");
+  }
+  return n;
+}
+
+std::vector<double> numbers(const YAML::Node& parent, const std::string& key,
+                            const std::string& where, const std::string& path) {
+  try {
+    return parent[key].as<std::vector<double>>();
+  } catch (const YAML::Exception&) {
+    fail(ErrorCode::PARSE_ERROR, path,
+         "'" + where + "." + key + "' is missing or not a list of numbers");
+  }
+}
+
+RadiusCalibration readTable(const YAML::Node& root, const std::string& key,
+                            const std::string& path) {
+  const YAML::Node n = section(root, key, {"radii_m", "noise_m", "bias_m"}, path);
+  RadiusCalibration t;
+  t.radii = numbers(n, "radii_m", key, path);
+  t.noise = numbers(n, "noise_m", key, path);
+  t.bias = numbers(n, "bias_m", key, path);
+  if (!t.valid()) {
+    fail(ErrorCode::INVALID_ARGUMENT, path,
+         key + ": radii_m and noise_m must be non-empty and ascending, bias_m must hold " +
+             std::to_string(t.radii.size() * t.noise.size()) +
+             " values (noise_m rows of radii_m; has " + std::to_string(t.bias.size()) + ")");
+  }
+  if (!(t.radii.front() > 0.0 && t.radii.back() <= MAX_RADIUS_M && t.noise.front() >= 0.0 &&
+        t.noise.back() <= MAX_NOISE_M))
+    fail(ErrorCode::INVALID_ARGUMENT, path,
+         key + ": radii_m outside (0, 1] m or noise_m outside [0, 0.1] m");
+  for (const double b : t.bias) {
+    if (!(std::abs(b) <= MAX_ABS_BIAS_M))
+      fail(ErrorCode::INVALID_ARGUMENT, path,
+           key + ": a bias of " + std::to_string(b) + " m is beyond +/-0.05 m");
+  }
+  return t;
+}
+
+std::pair<double, double> range(const YAML::Node& n, const std::string& key,
+                                const std::string& path) {
+  const auto v = numbers(n, key, "covers", path);
+  if (v.size() != 2 || !(v[0] >= 0.0 && v[1] >= v[0]))
+    fail(ErrorCode::INVALID_ARGUMENT, path,
+         "covers." + key + " must be [min, max] with 0 <= min <= max");
+  return {v[0], v[1]};
+}
+
+std::string list(const std::vector<double>& v) {
+  std::string s = "[";
+  char buf[32];
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    std::snprintf(buf, sizeof(buf), "%s%.5f", i ? ", " : "", v[i]);
+    s += buf;
+  }
+  return s + "]";
+}
+
+std::string tableYaml(const char* key, const RadiusCalibration& t) {
+  std::string s = std::string("  ") + key + ":\n    radii_m: " + list(t.radii) +
+                  "\n    noise_m: " + list(t.noise) + "\n    bias_m: [";
+  const std::size_t n = t.radii.size();
+  for (std::size_t k = 0; k < t.noise.size(); ++k) {
+    const std::vector<double> row(t.bias.begin() + k * n, t.bias.begin() + (k + 1) * n);
+    const std::string r = list(row);
+    s += (k ? ",\n             " : "") + r.substr(1, r.size() - 2);
+  }
+  return s + "]\n";
+}
+
+}  // namespace
+
+std::string fnv1aHex(const std::string& bytes) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+SensorCalibration loadSensorCalibration(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(ErrorCode::FILE_NOT_FOUND, "no such calibration file: " + path);
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof())
+    throw Error(ErrorCode::IO_FAILURE, "cannot read calibration file " + path);
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(text.str());
+  } catch (const YAML::Exception& e) {
+    fail(ErrorCode::PARSE_ERROR, path, e.what());
+  }
+  if (!doc.IsMap() || !doc[ROOT_KEY])
+    fail(ErrorCode::PARSE_ERROR, path, std::string("no top-level '") + ROOT_KEY + "' map");
+  const YAML::Node root = section(
+      doc, ROOT_KEY, {"name", "sources", "covers", "trunk_footprint", "branch_footprint"}, path);
+  SensorCalibration c;
+  try {
+    c.name = root["name"].as<std::string>();
+    if (root["sources"])
+      c.sources = root["sources"].as<std::vector<std::string>>();
+  } catch (const YAML::Exception&) {
+    fail(ErrorCode::PARSE_ERROR, path, "'name' must be a string and 'sources' a list of strings");
+  }
+  if (c.name.empty())
+    fail(ErrorCode::INVALID_ARGUMENT, path, "'name' is empty");
+  c.trunk_footprint = readTable(root, "trunk_footprint", path);
+  c.branch_footprint = readTable(root, "branch_footprint", path);
+  const YAML::Node covers =
+      section(root, "covers", {"trunk_radius_m", "branch_radius_m", "noise_m"}, path);
+  std::tie(c.coverage.trunk_radius_min_m, c.coverage.trunk_radius_max_m) =
+      range(covers, "trunk_radius_m", path);
+  std::tie(c.coverage.branch_radius_min_m, c.coverage.branch_radius_max_m) =
+      range(covers, "branch_radius_m", path);
+  std::tie(c.coverage.noise_min_m, c.coverage.noise_max_m) = range(covers, "noise_m", path);
+  c.hash = fnv1aHex(text.str());
+  return c;
+}
+
+std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::string& comment) {
+  std::ostringstream s;
+  std::istringstream lines(comment);
+  for (std::string line; std::getline(lines, line);)
+    s << "# " << line << "\n";
+  s << ROOT_KEY << ":\n  name: " << YAML::Node(c.name) << "\n";
+  if (!c.sources.empty()) {
+    s << "  sources:\n";
+    for (const auto& src : c.sources)
+      s << "    - " << YAML::Node(src) << "\n";
+  }
+  const auto& v = c.coverage;
+  s << "  covers:\n    trunk_radius_m: " << list({v.trunk_radius_min_m, v.trunk_radius_max_m})
+    << "\n    branch_radius_m: " << list({v.branch_radius_min_m, v.branch_radius_max_m})
+    << "\n    noise_m: " << list({v.noise_min_m, v.noise_max_m}) << "\n";
+  s << tableYaml("trunk_footprint", c.trunk_footprint)
+    << tableYaml("branch_footprint", c.branch_footprint);
+  return s.str();
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,266 @@
+// The diameter calibration: the noise part every scanner shares, the footprint part a rig scan
+// gives, the calibration file, and a tree of the rig's world measured through it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/evaluation/rig_calibration.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
+#include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/modeling/noise_bias.h"
+#include "dormant_tree_modeling/modeling/sensor_calibration.h"
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/simulation/calibration_rig.h"
+#include "dormant_tree_modeling/simulation/dataset.h"
+#include "temp_dir.h"
+
+namespace dormant_tree_modeling {
+namespace {
+
+using evaluation::RigScan;
+
+TEST(NoiseBias, ThickSectionsAreUnbiasedAndThinRodsWidenWithTheNoise) {
+  const modeling::ModelerConfig config;
+  const auto trunk = modeling::trunkNoiseBias(config);
+  const auto branch = modeling::branchNoiseBias(config);
+  ASSERT_TRUE(trunk.valid());
+  ASSERT_TRUE(branch.valid());
+  // The surface mode of a thick section under low noise is the surface.
+  EXPECT_LT(std::abs(trunk.biasAt(0.05, 0.003)), 0.0005);
+  // An RMS distance carries the noise: a 3 mm rod under 12 mm noise looks much wider, and more
+  // so than under 3 mm.
+  EXPECT_GT(branch.biasAt(0.003, 0.012), 0.003);
+  EXPECT_GT(branch.biasAt(0.003, 0.012), branch.biasAt(0.003, 0.003) + 0.002);
+  // Seeded: the same tables again.
+  EXPECT_EQ(modeling::trunkNoiseBias(config).bias, trunk.bias);
+}
+
+TEST(NoiseBias, TheFootprintIsAddedWithItsNoiseHeldToItsRows) {
+  modeling::RadiusCalibration noise_part;
+  noise_part.radii = {0.01, 0.02};
+  noise_part.noise = {0.002, 0.004, 0.020};
+  noise_part.bias = {0.001, 0.0, 0.002, 0.001, 0.006, 0.004};
+  modeling::RadiusCalibration footprint;
+  footprint.radii = {0.01, 0.02};
+  footprint.noise = {0.003, 0.005};
+  footprint.bias = {0.004, 0.002, 0.006, 0.004};
+  const auto sum = modeling::addFootprint(noise_part, footprint);
+  ASSERT_EQ(sum.bias.size(), 6u);
+  EXPECT_NEAR(sum.bias[0], 0.001 + 0.004, 1e-12);  // below the footprint's rows: its lowest
+  EXPECT_NEAR(sum.bias[3], 0.001 + 0.003, 1e-12);  // 4 mm: halfway between its rows
+  EXPECT_NEAR(sum.bias[4], 0.006 + 0.006, 1e-12);  // 20 mm: its highest row, not extrapolated
+  EXPECT_EQ(modeling::addFootprint(noise_part, {}).bias, noise_part.bias);
+}
+
+TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
+  test::TempDir dir;
+  modeling::SensorCalibration c;
+  c.name = "unit 1234";
+  c.sources = {"rig.pcd"};
+  c.trunk_footprint.radii = {0.01, 0.05};
+  c.trunk_footprint.noise = {0.006};
+  c.trunk_footprint.bias = {0.003, 0.001};
+  c.branch_footprint = c.trunk_footprint;
+  c.coverage = {0.01, 0.05, 0.003, 0.02, 0.006, 0.006};
+  const std::string path =
+      dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "made by a test"));
+  const auto back = modeling::loadSensorCalibration(path);
+  EXPECT_EQ(back.name, c.name);
+  EXPECT_EQ(back.sources, c.sources);
+  EXPECT_EQ(back.trunk_footprint.bias, c.trunk_footprint.bias);
+  EXPECT_DOUBLE_EQ(back.coverage.branch_radius_max_m, 0.02);
+  EXPECT_EQ(back.hash.size(), 16u);
+  auto code = [&](const std::string& text) {
+    try {
+      modeling::loadSensorCalibration(dir.write("bad.yaml", text));
+    } catch (const Error& e) {
+      return e.code();
+    }
+    return ErrorCode::IO_FAILURE;  // not thrown: fails the comparisons below
+  };
+  const std::string good = modeling::sensorCalibrationToYaml(c, "");
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  EXPECT_EQ(code("tree_modeler:\n  psi_t: 60\n"), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(replaced("radii_m: [0.01000, 0.05000]", "radii_m: [0.05000, 0.01000]")),
+            ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(replaced("bias_m: [0.00300", "bias_m: [0.30000")), ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(replaced("covers:", "coverage:")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(replaced("noise_m: [0.00600]", "noise_m: six")), ErrorCode::PARSE_ERROR);
+  EXPECT_THROW(modeling::loadSensorCalibration(dir.file("missing.yaml")), Error);
+  // Another file, another hash.
+  EXPECT_NE(
+      modeling::loadSensorCalibration(dir.write("other.yaml", replaced("unit 1234", "unit 99")))
+          .hash,
+      back.hash);
+}
+
+TEST(SensorCalibrationFile, OldTablesInTheModelerParametersAreRefusedWithTheWayOut) {
+  test::TempDir dir;
+  try {
+    modeling::loadModelerConfig(dir.write("old.yaml", "trunk_calibration_radii: [0.01]\n"));
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR);
+    EXPECT_NE(std::string(e.what()).find("calibrate_diameters"), std::string::npos);
+  }
+}
+
+TEST(SensorCalibrationFile, TheShippedSensorModelCalibrationLoads) {
+  const auto c = modeling::loadSensorCalibration(std::string(DTM_TEST_DATA_DIR) +
+                                                 "/../../config/calibration/lms111_model.yaml");
+  EXPECT_EQ(c.name, "lms111_model");
+  EXPECT_EQ(c.trunk_footprint.noise.size(), 3u);
+  EXPECT_LE(c.coverage.branch_radius_min_m, 0.003);
+}
+
+/// The simulated rig scanned with the whole plan at 6 mm noise, once for the suite.
+class RigCalibration : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    simulation::DatasetOptions o;
+    o.orchard.preset = simulation::CALIBRATION_RIG_PRESET;
+    o.sensor.range_noise_sigma = 0.006;
+    o.write_views = false;
+    simulation::writeDataset(o, dir_->file("rig"));
+    scan_ = new RigScan;
+    scan_->name = "rig";
+    scan_->rig = io::readTruthFile(dir_->file("rig/truth.json"));
+    scan_->points = io::readPointsInFileFrame(dir_->file("rig/target.pcd"));
+  }
+  static void TearDownTestSuite() {
+    delete scan_;
+    delete dir_;
+  }
+  static test::TempDir* dir_;
+  static RigScan* scan_;
+};
+test::TempDir* RigCalibration::dir_ = nullptr;
+RigScan* RigCalibration::scan_ = nullptr;
+
+TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
+  const auto result = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  int sections = 0, rods = 0;
+  for (const auto& s : result.samples)
+    (s.trunk ? sections : rods)++;
+  EXPECT_EQ(sections, 7);
+  EXPECT_EQ(rods, 20);
+  const auto& c = result.calibration;
+  ASSERT_TRUE(c.trunk_footprint.valid());
+  ASSERT_TRUE(c.branch_footprint.valid());
+  // Our sensor model's beam widens thin objects by millimetres, thick ones hardly.
+  const auto& t = c.branch_footprint.bias;
+  EXPECT_GT(t.front(), 0.002);
+  EXPECT_LT(t.front(), 0.010);
+  for (std::size_t i = 1; i < t.size(); ++i)
+    EXPECT_LE(t[i], t[i - 1]);
+  EXPECT_LT(std::abs(c.trunk_footprint.bias.back()), 0.001);
+  EXPECT_NEAR(c.coverage.branch_radius_min_m, 0.002, 1e-9);
+  EXPECT_NEAR(c.coverage.trunk_radius_max_m, 0.1, 1e-9);
+}
+
+TEST_F(RigCalibration, SurveyCoordinatesGiveTheSameCalibration) {
+  RigScan far = *scan_;
+  const Eigen::Vector3d offset(612345.0, 4423456.0, 210.0);
+  for (auto& p : far.points)
+    p += offset;
+  for (auto* line : {&far.rig.trunk}) {
+    for (auto& p : line->points)
+      p += offset;
+  }
+  for (auto& b : far.rig.primary_branches) {
+    for (auto& p : b.points)
+      p += offset;
+  }
+  const auto a = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "a");
+  const auto b = evaluation::calibrateFromRig({far}, modeling::ModelerConfig{}, "b");
+  ASSERT_EQ(a.calibration.branch_footprint.bias.size(), b.calibration.branch_footprint.bias.size());
+  for (std::size_t i = 0; i < a.calibration.branch_footprint.bias.size(); ++i)
+    EXPECT_NEAR(a.calibration.branch_footprint.bias[i], b.calibration.branch_footprint.bias[i],
+                2e-4);
+}
+
+TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable) {
+  const modeling::ModelerConfig config;
+  // An empty scan.
+  RigScan empty = *scan_;
+  empty.points.clear();
+  EXPECT_THROW(evaluation::calibrateFromRig({empty}, config, "x"), Error);
+  // Rods that are not in the scan: the rig file's rods 1.5 m beside the pipe.
+  RigScan turned = *scan_;
+  for (auto& b : turned.rig.primary_branches) {
+    for (auto& p : b.points)
+      p.x() += 1.5;
+  }
+  try {
+    evaluation::calibrateFromRig({turned}, config, "x");
+    FAIL() << "a table from rods that are not there";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NO_TRUNK);
+    EXPECT_NE(std::string(e.what()).find("no rod"), std::string::npos) << e.what();
+  }
+  // One rod's axis 20 cm off: named, the rest measured.
+  RigScan off = *scan_;
+  for (auto& p : off.rig.primary_branches[4].points)
+    p.x() += 0.2;
+  const auto r = evaluation::calibrateFromRig({off}, config, "x");
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("rod 4 "), std::string::npos) << r.warnings[0];
+  // A pipe of one diameter: said, and the table is constant over radius.
+  RigScan one = *scan_;
+  one.rig.trunk.points = {one.rig.trunk.points[6], one.rig.trunk.points[7]};
+  one.rig.trunk.diameters = {0.06, 0.06};
+  const auto single = evaluation::calibrateFromRig({one}, config, "x");
+  bool said = false;
+  for (const auto& w : single.warnings)
+    said = said || w.find("one diameter") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_EQ(single.calibration.trunk_footprint.radii.size(), 1u);
+  // No pipe section long enough, or no rods: not a rig.
+  RigScan bare = *scan_;
+  bare.rig.primary_branches.clear();
+  EXPECT_THROW(evaluation::calibrateFromRig({bare}, config, "x"), Error);
+}
+
+TEST_F(RigCalibration, ATreeOfTheSameWorldMeasuresWithinBoundsAndSaysWhichCalibration) {
+  auto result = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  result.calibration.hash = "0123456789abcdef";
+  simulation::DatasetOptions o;
+  o.seed = 41;  // not a bench tree
+  o.sensor.range_noise_sigma = 0.006;
+  o.write_views = false;
+  simulation::writeDataset(o, dir_->file("tree"));
+  const auto cloud = io::readPointsInFileFrame(dir_->file("tree/target.pcd"));
+  const auto truth = io::readTruthFile(dir_->file("tree/truth.json"));
+  modeling::ModelerConfig config;
+  config.calibration = result.calibration;
+  const auto model = modeling::TreeModeler(config).model(cloud).model;
+  const auto score = evaluation::evaluate(model, truth);
+  EXPECT_GE(score.f1, 0.9);
+  EXPECT_LT(score.branch_mae, 0.006);
+  EXPECT_LT(std::abs(score.branch_bias), 0.003);
+  EXPECT_LT(score.trunk_mae, 0.004);
+  EXPECT_EQ(model.correction.calibration, "sim");
+  EXPECT_EQ(model.correction.calibration_hash, "0123456789abcdef");
+  EXPECT_GT(model.correction.noise_sigma, 0.004);
+  // The model file carries it.
+  const auto back = io::modelFromJson(io::modelToJson(model));
+  EXPECT_EQ(back.correction.calibration, "sim");
+  EXPECT_EQ(back.correction.warnings, model.correction.warnings);
+  // Without a calibration the model says it corrected the noise alone.
+  const auto plain = modeling::TreeModeler(modeling::ModelerConfig{}).model(cloud).model;
+  ASSERT_FALSE(plain.correction.warnings.empty());
+  EXPECT_NE(plain.correction.warnings[0].find("no sensor calibration"), std::string::npos);
+  EXPECT_TRUE(plain.correction.calibration.empty());
+}
+
+}  // namespace
+}  // namespace dormant_tree_modeling
