@@ -9,7 +9,7 @@ foreach(test_source ${DTM_UNIT_TESTS})
   target_link_libraries(${test_name} dtm_core ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(${test_name} PRIVATE
     DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"
-    DTM_TOOL_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
+    DTM_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config" DTM_TOOL_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
 endforeach()
 # The tool tests run the built tools.
 if(TARGET test_tools)

@@ -5,12 +5,19 @@
 #include <cstdio>
 #include <map>
 
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <unordered_map>
+
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/io/pose_json.h"
+#include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
+#include "dormant_tree_modeling/registration/view_folder.h"
 
 namespace dormant_tree_modeling {
 namespace evaluation {
@@ -23,6 +30,12 @@ constexpr double MAX_ROD_ANGLE_DEG = 30.0;
 constexpr double MAX_ROD_ARC_M = 1.0;
 // A footprint this large is a mismatch (a rod found on the wrong part, a wrong diameter).
 constexpr double IMPLAUSIBLE_FOOTPRINT_M = 0.02;
+// Silhouette samples are tried on 2 cm voxels of the points near the rods; a fit's outliers
+// (a sample across two rods, at a rod's end) lie beyond 2.5 robust sigmas.
+constexpr double SILHOUETTE_VOXEL_M = 0.02;
+constexpr double SILHOUETTE_NEAR_ROD_M = 0.05;
+constexpr double SILHOUETTE_OUTLIER_SIGMAS = 2.5;
+constexpr double MIN_RANGE_SPREAD_M = 0.2;  // narrower: the growth is taken as constant
 
 struct Section {
   int index = 0;
@@ -80,6 +93,8 @@ void recentre(RigScan& scan) {
     move(b);
   for (auto& b : scan.rig.minor_branches)
     move(b);
+  for (auto& v : scan.views)
+    v.in_station = Eigen::Translation3d(-origin) * v.in_station;
 }
 
 /// Every rod the whole modeler finds near its stated axis, its raw radius; sets the scan's
@@ -299,7 +314,166 @@ void checkCoverage(const std::vector<RigSample>& samples, bool trunk, const char
   }
 }
 
+/// Distance from p to the segment a-b and the segment's unit direction.
+double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       Eigen::Vector3d* direction) {
+  const Eigen::Vector3d d = b - a;
+  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  *direction = d.normalized();
+  return (p - (a + t * d)).norm();
+}
+
+/// The rod whose axis a silhouette sample lies on, or -1.
+int rodOf(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const GroundTruth& rig,
+          const RigSearch& search) {
+  const double min_cos = std::cos(search.max_silhouette_angle_deg * M_PI / 180.0);
+  for (std::size_t k = 0; k < rig.primary_branches.size(); ++k) {
+    const auto& pts = rig.primary_branches[k].points;
+    Eigen::Vector3d rod_dir;
+    if (pts.size() >= 2 &&
+        segmentDistance(p, pts.front(), pts.back(), &rod_dir) < search.silhouette_reach_m &&
+        std::abs(rod_dir.dot(dir)) >= min_cos)
+      return static_cast<int>(k);
+  }
+  return -1;
+}
+
+bool nearARod(const Eigen::Vector3d& p, const GroundTruth& rig) {
+  for (const auto& rod : rig.primary_branches) {
+    Eigen::Vector3d dir;
+    if (rod.points.size() >= 2 && segmentDistance(p, rod.points.front(), rod.points.back(), &dir) <
+                                      0.5 * rod.diameters.front() + SILHOUETTE_NEAR_ROD_M)
+      return true;
+  }
+  return false;
+}
+
+struct GrowthSample {
+  double range, growth;
+};
+
+/// Per station (one side of the rig), the registration's axis samples on the rods with no
+/// growth taken off: twice their radius less the rod's diameter is the silhouette's growth.
+std::vector<GrowthSample> silhouetteSamples(const RigScan& scan, const RigSearch& search) {
+  std::map<int, std::vector<const registration::ViewInput*>> stations;
+  for (const auto& v : scan.views)
+    stations[v.station].push_back(&v);
+  std::vector<GrowthSample> out;
+  for (const auto& [id, views] : stations) {
+    modeling::Points pts, dirs, centres;
+    std::vector<double> ranges;
+    std::unordered_map<long long, char> voxels;
+    for (const auto* v : views) {
+      const Eigen::Vector3d sensor = v->in_station * v->sensor;
+      for (const auto& p : v->points) {
+        const Eigen::Vector3d q = v->in_station * p;
+        if (!q.allFinite() || !nearARod(q, scan.rig))
+          continue;
+        const Eigen::Vector3d d = sensor - q;
+        pts.push_back(q);
+        ranges.push_back(d.norm());
+        dirs.push_back(d.normalized());
+        const Eigen::Array3d cell = (q / SILHOUETTE_VOXEL_M).array().floor();
+        const long long key = (static_cast<long long>(cell.x()) * 73856093LL) ^
+                              (static_cast<long long>(cell.y()) * 19349663LL) ^
+                              (static_cast<long long>(cell.z()) * 83492791LL);
+        if (voxels.emplace(key, 1).second)
+          centres.push_back(q);
+      }
+    }
+    const auto axes =
+        registration::estimateAxes(pts, dirs, ranges, centres, registration::AxisConfig{});
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+      const int rod = rodOf(axes.points[i], axes.directions[i], scan.rig, search);
+      if (rod >= 0) {
+        out.push_back({axes.ranges[i],
+                       2.0 * axes.radii[i] - scan.rig.primary_branches[rod].diameters.front()});
+      }
+    }
+  }
+  return out;
+}
+
+/// growth = a + b range by least squares, refitted without the samples beyond 2.5 robust
+/// sigmas of the first fit; b = 0 when the ranges hardly vary.
+modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<GrowthSample>& samples) {
+  modeling::SensorCalibration::Silhouette s;
+  s.measured = true;
+  std::vector<double> r;
+  for (const auto& g : samples)
+    r.push_back(g.range);
+  s.range_min_m = *std::min_element(r.begin(), r.end());
+  s.range_max_m = *std::max_element(r.begin(), r.end());
+  std::vector<char> keep(samples.size(), 1);
+  for (int round = 0; round < 2; ++round) {
+    double n = 0, sr = 0, sg = 0, srr = 0, srg = 0;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (!keep[i])
+        continue;
+      n += 1;
+      sr += samples[i].range;
+      sg += samples[i].growth;
+      srr += samples[i].range * samples[i].range;
+      srg += samples[i].range * samples[i].growth;
+    }
+    const double var = srr / n - (sr / n) * (sr / n);
+    s.growth_per_m =
+        var > MIN_RANGE_SPREAD_M * MIN_RANGE_SPREAD_M ? (srg / n - sr / n * sg / n) / var : 0.0;
+    s.growth_m = sg / n - s.growth_per_m * sr / n;
+    std::vector<double> residuals;
+    for (const auto& g : samples)
+      residuals.push_back(std::abs(g.growth - s.growth_m - s.growth_per_m * g.range));
+    const double sigma = 1.4826 * median(residuals);
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      keep[i] = residuals[i] <= SILHOUETTE_OUTLIER_SIGMAS * sigma;
+  }
+  return s;
+}
+
 }  // namespace
+
+RigScan readRigViews(const std::string& dir, const GroundTruth& rig) {
+  registration::ViewFolderOptions o;
+  o.crop_radius = 0.0;
+  o.use_guesses = false;
+  o.ground_margin = -1.0;
+  registration::ViewFolder folder = registration::readViewFolder(dir, o);
+  std::map<std::string, Eigen::Isometry3d> registered;
+  const std::string reg = dir + "/registration.json";
+  if (std::filesystem::exists(reg)) {
+    const auto doc = nlohmann::json::parse(io::readTextFile(reg), nullptr, false);
+    if (doc.is_discarded() || !doc.contains("views") || !doc["views"].is_array())
+      throw Error(ErrorCode::PARSE_ERROR, reg + ": no 'views' array");
+    for (const auto& v : doc["views"]) {
+      const auto pose = io::poseFromJson(v, "pose");
+      if (pose && v.contains("name") && v["name"].is_string())
+        registered[v["name"].get<std::string>()] = *pose;
+    }
+  }
+  RigScan scan;
+  scan.name = dir;
+  scan.rig = rig;
+  for (std::size_t i = 0; i < folder.views.size(); ++i) {
+    registration::ViewInput v = folder.views[i];
+    if (folder.true_poses[i]) {
+      v.in_station = *folder.true_poses[i];
+    } else if (registered.count(v.name)) {
+      v.in_station = registered[v.name];
+    } else {
+      throw Error(ErrorCode::INVALID_ARGUMENT,
+                  dir + ": view " + v.name +
+                      " has no true_pose in views.json and no pose in registration.json: "
+                      "register the rig's views (register_views) and copy registration.json "
+                      "into the folder");
+    }
+    for (const auto& p : v.points) {
+      if (p.allFinite())
+        scan.points.push_back(v.in_station * p);
+    }
+    scan.views.push_back(std::move(v));
+  }
+  return scan;
+}
 
 RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
                                       const modeling::ModelerConfig& config,
@@ -312,6 +486,8 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   const auto branch_noise = modeling::branchNoiseBias(raw);
   RigCalibrationResult result;
   std::vector<double> sigmas;
+  std::vector<GrowthSample> silhouette;
+  bool with_views = false;
   for (RigScan scan : scans) {
     if (scan.points.empty())
       throw Error(ErrorCode::EMPTY_INPUT, "rig scan " + scan.name + " has no points");
@@ -333,6 +509,9 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
     result.samples.insert(result.samples.end(), sections.begin(), sections.end());
     result.samples.insert(result.samples.end(), rods.begin(), rods.end());
     sigmas.push_back(sigma);
+    const auto growth = silhouetteSamples(scan, search);
+    silhouette.insert(silhouette.end(), growth.begin(), growth.end());
+    with_views = with_views || !scan.views.empty();
     result.calibration.sources.push_back(scan.name);
   }
   modeling::SensorCalibration& c = result.calibration;
@@ -346,6 +525,16 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   c.coverage.noise_max_m = rows.back();
   c.trunk_footprint = footprintTable(result.samples, true, rows);
   c.branch_footprint = footprintTable(result.samples, false, rows);
+  if (silhouette.size() >= static_cast<std::size_t>(search.min_silhouette_samples)) {
+    c.silhouette = fitGrowth(silhouette);
+  } else {
+    result.warnings.push_back(
+        with_views ? "only " + std::to_string(silhouette.size()) +
+                         " silhouette samples on the rods: the registration's silhouette growth "
+                         "is not calibrated"
+                   : "the rig was given as a cloud, not as views: the registration's silhouette "
+                     "growth is not calibrated (give the rig's views folder as --scan)");
+  }
   return result;
 }
 

@@ -135,7 +135,8 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   if (!doc.IsMap() || !doc[ROOT_KEY])
     fail(ErrorCode::PARSE_ERROR, path, std::string("no top-level '") + ROOT_KEY + "' map");
   const YAML::Node root = section(
-      doc, ROOT_KEY, {"name", "sources", "covers", "trunk_footprint", "branch_footprint"}, path);
+      doc, ROOT_KEY,
+      {"name", "sources", "covers", "trunk_footprint", "branch_footprint", "silhouette"}, path);
   SensorCalibration c;
   try {
     c.name = root["name"].as<std::string>();
@@ -155,6 +156,20 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   std::tie(c.coverage.branch_radius_min_m, c.coverage.branch_radius_max_m) =
       range(covers, "branch_radius_m", path);
   std::tie(c.coverage.noise_min_m, c.coverage.noise_max_m) = range(covers, "noise_m", path);
+  if (root["silhouette"]) {
+    const YAML::Node s =
+        section(root, "silhouette", {"growth_m", "growth_per_m", "ranges_m"}, path);
+    const auto growth = numbers(s, "growth_m", "silhouette", path);
+    const auto per_m = numbers(s, "growth_per_m", "silhouette", path);
+    const auto ranges = numbers(s, "ranges_m", "silhouette", path);
+    if (growth.size() != 1 || per_m.size() != 1 || ranges.size() != 2 ||
+        !(std::abs(growth[0]) <= MAX_ABS_BIAS_M && std::abs(per_m[0]) <= MAX_ABS_BIAS_M) ||
+        !(ranges[0] >= 0.0 && ranges[1] >= ranges[0]))
+      fail(ErrorCode::INVALID_ARGUMENT, path,
+           "silhouette: growth_m and growth_per_m are [one number] within +/-0.05, ranges_m is "
+           "[min, max]");
+    c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1]};
+  }
   c.hash = fnv1aHex(text.str());
   return c;
 }
@@ -176,6 +191,11 @@ std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::strin
     << "\n    noise_m: " << list({v.noise_min_m, v.noise_max_m}) << "\n";
   s << tableYaml("trunk_footprint", c.trunk_footprint)
     << tableYaml("branch_footprint", c.branch_footprint);
+  if (c.silhouette.measured) {
+    s << "  silhouette:\n    growth_m: " << list({c.silhouette.growth_m})
+      << "\n    growth_per_m: " << list({c.silhouette.growth_per_m})
+      << "\n    ranges_m: " << list({c.silhouette.range_min_m, c.silhouette.range_max_m}) << "\n";
+  }
   return s.str();
 }
 

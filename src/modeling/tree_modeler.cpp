@@ -355,15 +355,17 @@ DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeMod
 
 }  // namespace
 
-TreeModeler::TreeModeler(const ModelerConfig& config) : config_(config) {
-  config_.validate();
-  if (config_.ours_correct_noise_bias) {
-    config_.trunk_calibration =
-        addFootprint(trunkNoiseBias(config_), config_.calibration.trunk_footprint);
-    config_.branch_calibration =
-        addFootprint(branchNoiseBias(config_), config_.calibration.branch_footprint);
+ModelerConfig stageConfig(const ModelerConfig& config) {
+  config.validate();
+  ModelerConfig c = config;
+  if (c.ours_correct_noise_bias) {
+    c.trunk_calibration = addFootprint(trunkNoiseBias(c), c.calibration.trunk_footprint);
+    c.branch_calibration = addFootprint(branchNoiseBias(c), c.calibration.branch_footprint);
   }
+  return c;
 }
+
+TreeModeler::TreeModeler(const ModelerConfig& config) : config_(stageConfig(config)) {}
 
 ModelResult TreeModeler::model(const Cloud& cloud) const {
   Points pts;

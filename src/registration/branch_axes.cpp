@@ -16,7 +16,7 @@ namespace {
 
 struct Sample {
   Eigen::Vector3d point, direction, view;
-  double radius;
+  double radius, range;
 };
 
 // One side's half of a branch around one centre: the axis from PCA, the radius from the
@@ -69,8 +69,8 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
   const double n = static_cast<double>(in_slab.size());
   const double mid = sum / n;
   const double width = std::sqrt(12.0 * std::max(sum_sq / n - mid * mid, 0.0));
-  const double footprint = c.beam_exit + c.beam_divergence * median(patch_ranges);
-  const double radius = 0.5 * (width - c.silhouette_fraction * footprint);
+  const double range = median(patch_ranges);
+  const double radius = 0.5 * (width - c.silhouette_growth_m - c.silhouette_growth_per_m * range);
   if (!(radius >= c.min_radius && radius <= c.max_radius))
     return std::nullopt;
   // A point at offset x from the axis (across) lies sqrt(r^2 - x^2) in front of it; beams
@@ -83,7 +83,7 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
     offsets.push_back(d.dot(depth) - std::sqrt(std::max(radius * radius - x * x, 0.0)));
   }
   const double behind = median(offsets);
-  return Sample{centroid + mid * across + behind * depth, axis, view, radius};
+  return Sample{centroid + mid * across + behind * depth, axis, view, radius, range};
 }
 
 }  // namespace
@@ -101,9 +101,8 @@ void AxisConfig::validate() const {
           "axis_min_view_agreement must be in [0, 1]");
   require(min_radius >= 0 && max_radius > min_radius,
           "axis radii need 0 <= axis_min_radius < axis_max_radius");
-  require(beam_exit >= 0 && beam_divergence >= 0, "beam_exit and beam_divergence must be >= 0");
-  require(silhouette_fraction >= 0 && silhouette_fraction <= 1,
-          "silhouette_fraction must be in [0, 1]");
+  require(std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
+          "silhouette growth must be within +/-0.05 m and +/-0.05 m per m");
 }
 
 AxisSamples estimateAxes(const Points& pts, const Points& view_dirs,
@@ -128,6 +127,7 @@ AxisSamples estimateAxes(const Points& pts, const Points& view_dirs,
     out.directions.push_back(s->direction);
     out.view_dirs.push_back(s->view);
     out.radii.push_back(s->radius);
+    out.ranges.push_back(s->range);
   }
   return out;
 }
@@ -142,6 +142,7 @@ void appendTransformed(AxisSamples& a, const AxisSamples& b, const Eigen::Isomet
     a.view_dirs.push_back(t.linear() * b.view_dirs[i]);
   }
   a.radii.insert(a.radii.end(), b.radii.begin(), b.radii.end());
+  a.ranges.insert(a.ranges.end(), b.ranges.begin(), b.ranges.end());
 }
 
 }  // namespace registration

@@ -102,6 +102,10 @@ dormant_tree_modeling::TreeModel toMsg(const modeling::TreeModel& model,
   }
   msg.input_points = static_cast<std::uint32_t>(model.input_points);
   msg.processing_time = model.runtime_s;
+  msg.calibration = model.correction.calibration;
+  msg.calibration_hash = model.correction.calibration_hash;
+  msg.noise_sigma = model.correction.noise_sigma;
+  msg.warnings = model.correction.warnings;
   return msg;
 }
 

@@ -24,15 +24,30 @@ namespace {
 // How often the end of the input is looked for, s.
 constexpr double END_OF_INPUT_CHECK_S = 1.0;
 
+/// The silhouette growth of ~calibration_file's sensor calibration; none (said) without one.
+registration::RegistrationConfig withCalibration(registration::RegistrationConfig config,
+                                                 ros::NodeHandle& pnh) {
+  const std::string file = pnh.param<std::string>("calibration_file", "");
+  const bool applied = !file.empty() && registration::applySensorCalibration(
+                                            modeling::loadSensorCalibration(file), config);
+  if (!applied) {
+    ROS_WARN(
+        "registration: no silhouette growth in ~calibration_file ('%s'): branch axes assume "
+        "an ideal beam (calibrate the rig's views with calibrate_diameters)",
+        file.c_str());
+  }
+  return config;
+}
+
 registration::RegistrationConfig loadConfig(ros::NodeHandle& pnh) {
   const std::string file = pnh.param<std::string>("config_file", "");
   if (file.empty()) {
     ROS_WARN(
         "~config_file not set: using the built-in defaults (config/registration.yaml holds "
         "them too)");
-    return registration::RegistrationConfig{};
+    return withCalibration(registration::RegistrationConfig{}, pnh);
   }
-  return registration::loadRegistrationConfig(file);
+  return withCalibration(registration::loadRegistrationConfig(file), pnh);
 }
 
 std::string defaultOutputDir() {

@@ -24,15 +24,30 @@ namespace ros_layer {
 
 namespace {
 
+/// The sensor calibration of ~calibration_file; none (said once) when it is empty.
+modeling::ModelerConfig withCalibration(modeling::ModelerConfig config, ros::NodeHandle& pnh) {
+  const std::string file = pnh.param<std::string>("calibration_file", "");
+  if (file.empty()) {
+    ROS_WARN(
+        "~calibration_file not set: diameters are corrected for range noise only, not for the "
+        "scanner's beam footprint (make a calibration with calibrate_diameters)");
+    return config;
+  }
+  config.calibration = modeling::loadSensorCalibration(file);
+  ROS_INFO("tree_modeler: sensor calibration '%s' (%s) from %s", config.calibration.name.c_str(),
+           config.calibration.hash.c_str(), file.c_str());
+  return config;
+}
+
 modeling::ModelerConfig loadConfig(ros::NodeHandle& pnh) {
   const std::string file = pnh.param<std::string>("config_file", "");
   if (file.empty()) {
     ROS_WARN(
         "~config_file not set: using the built-in defaults (config/tree_modeler.yaml holds them "
         "too)");
-    return modeling::ModelerConfig{};
+    return withCalibration(modeling::ModelerConfig{}, pnh);
   }
-  return modeling::loadModelerConfig(file);
+  return withCalibration(modeling::loadModelerConfig(file), pnh);
 }
 
 sensor_msgs::PointCloud2 segmentsMsg(const modeling::ModelResult& result,
@@ -159,6 +174,7 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
     if (dropped > 0)
       ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
     const modeling::ModelResult result = modeler_.model(*cloud);
+    warnOnce(result.model.correction.warnings);
     const std::string summary = publish(result, msg.header);
     if (!output_dir_.empty())
       writeFiles(result.model, *cloud, msg.header);
@@ -170,6 +186,14 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
   } catch (const std::exception& e) {
     noteOutcome(false, e.what());
     throw;
+  }
+}
+
+void TreeModelerNode::warnOnce(const std::vector<std::string>& warnings) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& w : warnings) {
+    if (warned_.insert(w).second)
+      ROS_WARN("tree_modeler: %s", w.c_str());
   }
 }
 

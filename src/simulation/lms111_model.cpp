@@ -31,6 +31,35 @@ int Lms111Config::beamCount() const {
   return static_cast<int>(std::lround((stop_angle_deg - start_angle_deg) / angular_resolution_deg));
 }
 
+std::vector<std::string> sensorVariantNames() {
+  return {"ours", "thin_beam", "wide_beam", "far_noise"};
+}
+
+Lms111Config sensorVariant(const std::string& name) {
+  Lms111Config c;
+  if (name == "ours")
+    return c;
+  if (name == "thin_beam") {
+    c.beam_samples = 1;
+    return c;
+  }
+  if (name == "wide_beam") {
+    c.beam_exit_diameter = 0.012;
+    c.beam_divergence = 0.025;
+    return c;
+  }
+  if (name == "far_noise") {
+    c.range_noise_per_m = 0.002;
+    c.echo_merge_distance = 1.2;
+    return c;
+  }
+  std::string names;
+  for (const auto& n : sensorVariantNames())
+    names += (names.empty() ? "" : ", ") + n;
+  throw Error(ErrorCode::INVALID_ARGUMENT,
+              "unknown sensor variant '" + name + "' (known: " + names + ")");
+}
+
 void Lms111Config::validate() const {
   require(angular_resolution_deg == 0.25 || angular_resolution_deg == 0.5,
           "angular_resolution_deg must be 0.25 or 0.5");
@@ -45,6 +74,8 @@ void Lms111Config::validate() const {
           "angles must satisfy -45 <= start < stop <= 225 deg + one step");
   require(min_range >= 0.0 && max_range > min_range, "need 0 <= min_range < max_range");
   require(range_noise_sigma >= 0.0, "range_noise_sigma must be >= 0");
+  require(range_noise_per_m >= 0.0 && range_noise_per_m <= 0.05,
+          "range_noise_per_m must be in [0, 0.05]");
   require(std::abs(range_bias) < 1.0, "range_bias must be within +/-1 m");
   require(beam_exit_diameter >= 0.0 && beam_divergence >= 0.0, "beam size must be >= 0");
   require(beam_samples == 1 || beam_samples == 7, "beam_samples must be 1 or 7");
@@ -131,8 +162,9 @@ ScanLine Lms111Model::scanLine(const Eigen::Isometry3d& laser_pose, Rng& rng) co
                      0.0, 1.0);
       if (p_drop > 0.0 && rng.bernoulli(p_drop))
         break;
-      const double range =
-          weighted_t / energy + config_.range_bias + rng.normal(0.0, config_.range_noise_sigma);
+      const double true_range = weighted_t / energy;
+      const double sigma = config_.range_noise_sigma + config_.range_noise_per_m * true_range;
+      const double range = true_range + config_.range_bias + rng.normal(0.0, sigma);
       if (range >= config_.min_range && range <= config_.max_range) {
         line.ranges[j] = static_cast<float>(range);
         line.rssi[j] = static_cast<std::uint8_t>(

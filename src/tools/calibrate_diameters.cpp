@@ -2,6 +2,7 @@
 // diameters (RIG.json: the truth schema, the pipe as trunk, the rods as primary branches).
 #include <boost/program_options.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "command_line.h"
@@ -15,13 +16,16 @@ using namespace dormant_tree_modeling;
 
 namespace {
 
-/// A rig scan in double precision, the file's offset put back: the rig file is in the
-/// scan's own (maybe survey) coordinates.
-evaluation::RigScan readRigScan(const std::string& cloud_path, const std::string& rig_path) {
+/// A rig scan in double precision in the rig file's frame: a cloud (its offset put back) or a
+/// folder of views (views.json; each view by its true or registered pose).
+evaluation::RigScan readRigScan(const std::string& path, const std::string& rig_path) {
+  const auto rig = io::readTruthFile(rig_path);
+  if (std::filesystem::is_directory(path))
+    return evaluation::readRigViews(path, rig);
   evaluation::RigScan scan;
-  scan.name = cloud_path;
-  scan.rig = io::readTruthFile(rig_path);
-  scan.points = io::readPointsInFileFrame(cloud_path);
+  scan.name = path;
+  scan.rig = rig;
+  scan.points = io::readPointsInFileFrame(path);
   return scan;
 }
 
@@ -44,6 +48,14 @@ void printSamples(const evaluation::RigCalibrationResult& result) {
                 1000 * c.branch_radius_min_m, 1000 * c.branch_radius_max_m, 1000 * c.noise_min_m,
                 1000 * c.noise_max_m);
   std::cerr << line;
+  const auto& s = result.calibration.silhouette;
+  if (s.measured) {
+    std::snprintf(
+        line, sizeof(line),
+        "silhouette growth: %.2f mm + %.2f mm per m of range (rods seen at %.2f-%.2f m)\n",
+        1000 * s.growth_m, 1000 * s.growth_per_m, s.range_min_m, s.range_max_m);
+    std::cerr << line;
+  }
 }
 
 }  // namespace

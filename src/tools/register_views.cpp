@@ -16,9 +16,10 @@ namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
 int main(int argc, char** argv) {
-  std::string dir, out, params;
+  std::string dir, out, params, calibration;
   po::options_description desc(
-      "Usage: register_views DIR [--output OUT] [--params registration.yaml] [--no-hints] "
+      "Usage: register_views DIR [--output OUT] [--params registration.yaml] [--calibration FILE] "
+      "[--no-hints] "
       "[--no-crop]\n"
       "Registers all views of DIR (views.json, views/<name>.pcd) into the frame of the first "
       "view and writes OUT/registered.pcd, registered.ply, registration.json and "
@@ -28,6 +29,9 @@ int main(int argc, char** argv) {
   desc.add_options()("help,h", "this help")("dir", po::value(&dir)->required(), "folder of views")(
       "output,o", po::value(&out), "output folder")(
       "params,p", po::value(&params), "registration parameters (config/registration.yaml)")(
+      "calibration,c", po::value(&calibration),
+      "the scanner's calibration file (calibrate_diameters on the rig's views): how much its "
+      "beam widens branch silhouettes; without one, an ideal beam")(
       "no-hints",
       "ignore the guessed platform poses: a global search from scratch (slide moves are kept)")(
       "no-crop",
@@ -44,6 +48,11 @@ int main(int argc, char** argv) {
     registration::RegistrationConfig config;
     if (!params.empty())
       config = registration::loadRegistrationConfig(params);
+    if (calibration.empty() || !registration::applySensorCalibration(
+                                   modeling::loadSensorCalibration(calibration), config)) {
+      std::cerr << "register_views: warning: no silhouette growth calibrated: branch axes assume "
+                   "an ideal beam\n";
+    }
     if (vm.count("no-hints"))
       config.use_hints = false;
     registration::ViewFolderOptions fo;

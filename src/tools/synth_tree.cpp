@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   simulation::DatasetOptions opt;
   std::string out, views;
   double noise_mm = 12.0, resolution = 0.25;
+  std::string sensor = "ours";
   po::options_description desc(
       "Usage: synth_tree --preset NAME --seed N --out DIR [options]\n"
       "Writes scene.json, truth.json, views.json, views/, merged.pcd/.ply, target.pcd, "
@@ -27,8 +28,9 @@ int main(int argc, char** argv) {
       "views", po::value(&views), "view plan YAML (default: the paper's 40 views)")(
       "resolution", po::value(&resolution)->default_value(resolution),
       "angular resolution, deg: 0.25 (25 Hz) or 0.5 (50 Hz)")(
-      "beam-samples", po::value(&opt.sensor.beam_samples)->default_value(opt.sensor.beam_samples),
-      "rays per beam footprint: 7 (mixed pixels) or 1 (ideal thin beam)")(
+      "sensor", po::value(&sensor)->default_value(sensor),
+      "sensor physics: ours | thin_beam (no footprint widening) | wide_beam | far_noise (noise "
+      "growing with range, more mixed pixels)")(
       "no-clutter", "target tree only: no neighbours, rows, wires or post")(
       "no-view-files", "skip the per-view range images and clouds")(
       "threads", po::value(&opt.threads)->default_value(0), "worker threads, 0 = all cores");
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
     po::variables_map vm;
     if (tools::parseOrHelp(argc, argv, desc, vm))
       return 0;
+    opt.sensor = simulation::sensorVariant(sensor);
     opt.sensor.range_noise_sigma = noise_mm / 1000.0;
     opt.sensor.angular_resolution_deg = resolution;
     opt.sensor.scan_frequency_hz = resolution == 0.5 ? 50.0 : 25.0;

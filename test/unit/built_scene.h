@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
 namespace dormant_tree_modeling {
@@ -43,6 +44,7 @@ inline BuiltTrunk buildTrunk(const Points& pts, std::size_t trunk_points) {
   BuiltTrunk b;
   b.region.resize(trunk_points);
   std::iota(b.region.begin(), b.region.end(), 0);
+  b.config = modeling::stageConfig(b.config);
   b.config.noise_sigma = 0.002;
   b.trunk = modeling::modelTrunk(pts, b.region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, b.config);
   return b;

@@ -51,12 +51,9 @@ HalfView seeHalves(const std::vector<Stick>& sticks, const Eigen::Vector3d& sens
   return v;
 }
 
-// Ideal beams (no footprint): the silhouette is the branch's width.
+// Ideal beams (no footprint, the default): the silhouette is the branch's width.
 AxisConfig idealBeams() {
-  AxisConfig c;
-  c.beam_exit = 0;
-  c.beam_divergence = 0;
-  return c;
+  return AxisConfig{};
 }
 
 // Distance from p to the stick's axis line.
@@ -144,10 +141,12 @@ TEST(BranchAxes, SkipPlanesTrunksAndMixedSides) {
       0u);
   // The beam footprint widens the silhouette: beams half on the branch report its edge. Taken
   // off, the radius is the branch's (a wider patch holds the widened silhouette whole).
-  AxisConfig beams;  // LMS111: 8 mm + 15 mrad; at 2 m a 38 mm footprint
+  AxisConfig beams;  // a calibrated growth: 2 mm + 8 mm per metre, 18 mm at 2 m
   beams.patch = 0.1;
+  beams.silhouette_growth_m = 0.002;
+  beams.silhouette_growth_per_m = 0.008;
   HalfView wide = seeHalves({STICKS.front()}, {0, -2, 1.5}, 0, 1);
-  const double grow = 0.5 * beams.silhouette_fraction * (0.008 + 0.015 * 2.0);
+  const double grow = 0.5 * (0.002 + 0.008 * 2.0);
   for (const double side : {1.0, -1.0}) {
     for (double z = 0.02 + 0.0015; z <= 0.02 + grow; z += 0.003) {
       for (double x = -0.25; x <= 0.25; x += 0.004) {
@@ -166,7 +165,7 @@ TEST(BranchAxes, SkipPlanesTrunksAndMixedSides) {
 
 TEST(BranchAxes, RejectBadInput) {
   AxisConfig bad;
-  bad.silhouette_fraction = 1.5;
+  bad.silhouette_growth_per_m = 0.5;
   EXPECT_THROW(bad.validate(), Error);
   bad = AxisConfig{};
   bad.max_radius = 0.001;

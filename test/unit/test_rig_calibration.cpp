@@ -13,6 +13,7 @@
 #include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/sensor_calibration.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/registration/multi_view.h"
 #include "dormant_tree_modeling/simulation/calibration_rig.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 #include "temp_dir.h"
@@ -65,6 +66,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   c.trunk_footprint.bias = {0.003, 0.001};
   c.branch_footprint = c.trunk_footprint;
   c.coverage = {0.01, 0.05, 0.003, 0.02, 0.006, 0.006};
+  c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4};
   const std::string path =
       dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "made by a test"));
   const auto back = modeling::loadSensorCalibration(path);
@@ -73,6 +75,16 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_EQ(back.trunk_footprint.bias, c.trunk_footprint.bias);
   EXPECT_DOUBLE_EQ(back.coverage.branch_radius_max_m, 0.02);
   EXPECT_EQ(back.hash.size(), 16u);
+  EXPECT_TRUE(back.silhouette.measured);
+  EXPECT_DOUBLE_EQ(back.silhouette.growth_per_m, 0.0085);
+  registration::RegistrationConfig reg;
+  EXPECT_TRUE(registration::applySensorCalibration(back, reg));
+  EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.0015);
+  modeling::SensorCalibration without = back;
+  without.silhouette = {};
+  registration::RegistrationConfig ideal;
+  EXPECT_FALSE(registration::applySensorCalibration(without, ideal));
+  EXPECT_DOUBLE_EQ(ideal.axes.silhouette_growth_per_m, 0.0);
   auto code = [&](const std::string& text) {
     try {
       modeling::loadSensorCalibration(dir.write("bad.yaml", text));
@@ -103,6 +115,15 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
 
 TEST(SensorCalibrationFile, OldTablesInTheModelerParametersAreRefusedWithTheWayOut) {
   test::TempDir dir;
+  for (const char* key : {"beam_exit", "beam_divergence", "silhouette_fraction"}) {
+    try {
+      registration::loadRegistrationConfig(dir.write("reg.yaml", std::string(key) + ": 0.3\n"));
+      FAIL() << key << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::PARSE_ERROR);
+      EXPECT_NE(std::string(e.what()).find("calibrate_diameters"), std::string::npos);
+    }
+  }
   try {
     modeling::loadModelerConfig(dir.write("old.yaml", "trunk_calibration_radii: [0.01]\n"));
     FAIL() << "accepted";
@@ -128,7 +149,6 @@ class RigCalibration : public ::testing::Test {
     simulation::DatasetOptions o;
     o.orchard.preset = simulation::CALIBRATION_RIG_PRESET;
     o.sensor.range_noise_sigma = 0.006;
-    o.write_views = false;
     simulation::writeDataset(o, dir_->file("rig"));
     scan_ = new RigScan;
     scan_->name = "rig";
@@ -147,7 +167,8 @@ RigScan* RigCalibration::scan_ = nullptr;
 
 TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
   const auto result = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
-  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  ASSERT_EQ(result.warnings.size(), 1u);  // a cloud: no silhouette
+  EXPECT_NE(result.warnings[0].find("given as a cloud"), std::string::npos);
   int sections = 0, rods = 0;
   for (const auto& s : result.samples)
     (s.trunk ? sections : rods)++;
@@ -165,6 +186,26 @@ TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
   EXPECT_LT(std::abs(c.trunk_footprint.bias.back()), 0.001);
   EXPECT_NEAR(c.coverage.branch_radius_min_m, 0.002, 1e-9);
   EXPECT_NEAR(c.coverage.trunk_radius_max_m, 0.1, 1e-9);
+}
+
+TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
+  const RigScan views = evaluation::readRigViews(dir_->file("rig"), scan_->rig);
+  EXPECT_EQ(views.views.size(), 40u);
+  const auto r = evaluation::calibrateFromRig({views}, modeling::ModelerConfig{}, "sim");
+  const auto& s = r.calibration.silhouette;
+  ASSERT_TRUE(s.measured);
+  // Our sensor model's beam: 8 mm + 15 mrad, 38 mm across at 2 m; a beam a few tenths on a rod
+  // still returns with the rod's range, so at 2 m the silhouette grows by about half of that.
+  const double at_2m = s.growth_m + 2.0 * s.growth_per_m;
+  EXPECT_GT(at_2m, 0.010);
+  EXPECT_LT(at_2m, 0.030);
+  EXPECT_GT(s.growth_per_m, 0.0);
+  EXPECT_LT(s.range_min_m, 1.6);
+  // The same rig as a cloud cannot tell the sides apart: said, and nothing measured.
+  const auto cloud = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  EXPECT_FALSE(cloud.calibration.silhouette.measured);
+  ASSERT_EQ(cloud.warnings.size(), 1u);
+  EXPECT_NE(cloud.warnings[0].find("not calibrated"), std::string::npos);
 }
 
 TEST_F(RigCalibration, SurveyCoordinatesGiveTheSameCalibration) {
@@ -212,7 +253,7 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
   for (auto& p : off.rig.primary_branches[4].points)
     p.x() += 0.2;
   const auto r = evaluation::calibrateFromRig({off}, config, "x");
-  ASSERT_EQ(r.warnings.size(), 1u);
+  ASSERT_EQ(r.warnings.size(), 2u);  // and the cloud's silhouette
   EXPECT_NE(r.warnings[0].find("rod 4 "), std::string::npos) << r.warnings[0];
   // A pipe of one diameter: said, and the table is constant over radius.
   RigScan one = *scan_;

@@ -13,6 +13,7 @@
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
+#include "sensor_model.h"
 #include "temp_dir.h"
 
 namespace dormant_tree_modeling {
@@ -74,7 +75,7 @@ Scan scanTree(const std::string& preset, std::uint64_t seed, double noise) {
 
 TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
   const Scan scan = scanTree("young_tall_spindle", 3, 0.006);
-  const TreeModeler modeler(ModelerConfig{});
+  const TreeModeler modeler(test::sensorModelConfig());
   const ModelResult result = modeler.model(*scan.cloud);
   const auto score = evaluation::evaluate(result.model, scan.truth);
   RecordProperty("f1", std::to_string(score.f1));

@@ -7,6 +7,7 @@
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/sensor_calibration.h"
+#include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
 namespace evaluation {
@@ -19,7 +20,17 @@ struct RigScan {
   std::string name;  ///< for messages and the calibration's sources
   modeling::Points points;
   GroundTruth rig;
+  /// The views the scan was merged from, each with its pose into the rig's frame as
+  /// `in_station` (optional): with them the silhouette growth of the registration's branch
+  /// axes is measured on the rods, each station's side apart.
+  std::vector<registration::ViewInput> views;
 };
+
+/// @brief A rig scan from a folder of views (views.json, views/<name>.pcd): each view put
+/// into the rig's frame by its `true_pose` in views.json or, without one, by its pose in the
+/// folder's registration.json (register_views' output, copied there).
+/// @throws Error FILE_NOT_FOUND, PARSE_ERROR; INVALID_ARGUMENT when a view has no pose
+RigScan readRigViews(const std::string& dir, const GroundTruth& rig);
 
 /// @brief One measured pipe section or rod.
 struct RigSample {
@@ -46,6 +57,11 @@ struct RigSearch {
   double axis_tolerance_m = 0.08;  ///< a rod or section this far from its stated axis is found
   double section_margin_m = 0.06;  ///< left out at each end of a pipe section (steps, rods)
   int min_slices = 3;              ///< slice circles a section needs to be measured
+  /// A silhouette sample belongs to a rod when its axis point lies this close to the rod's
+  /// axis and its direction within max_silhouette_angle_deg of the rod's.
+  double silhouette_reach_m = 0.02;
+  double max_silhouette_angle_deg = 20.0;
+  int min_silhouette_samples = 20;  ///< fewer: the silhouette is not measured (warned)
 };
 
 /// @brief Measure every rod and pipe section of the rig in each scan with the modeler's own

@@ -28,6 +28,14 @@ struct SensorCalibration {
   RadiusCalibration trunk_footprint;   ///< of the trunk step's slice radius
   RadiusCalibration branch_footprint;  ///< of the branch step's raw radius
   CalibrationCoverage coverage;
+  /// How much wider than its diameter a thin branch's one-sided silhouette looks, over the
+  /// range: growth_m + growth_per_m x range (m), for the registration's branch axes. Measured
+  /// when the rig was given as views (calibrate_diameters --scan DIR); absent otherwise.
+  struct Silhouette {
+    bool measured = false;
+    double growth_m = 0.0, growth_per_m = 0.0;
+    double range_min_m = 0.0, range_max_m = 0.0;  ///< the ranges the rig's rods were seen at
+  } silhouette;
   std::vector<std::string> sources;  ///< the scans it was made from, for the record
 
   /// @brief Whether a calibration is set.

@@ -45,6 +45,12 @@ struct ModelResult {
   std::vector<TrunkCandidate> trunk_candidates;         ///< trunk bases tracked
 };
 
+/// @brief The configuration as the stages run it: validated, and with ours_correct_noise_bias
+/// the radius tables filled (the noise part plus the calibration's footprint). For calling the
+/// stages (modelTrunk, modelBranches) directly as TreeModeler does.
+/// @throws Error INVALID_ARGUMENT
+ModelerConfig stageConfig(const ModelerConfig& config);
+
 /// @brief Algorithms 2 and 3 of the paper (docs/algorithms.md), plus the switchable additions of
 /// ModelerConfig, from a point cloud of one tree to trunk and primary-branch cylinders.
 class TreeModeler {

@@ -10,8 +10,8 @@ namespace registration {
 
 using modeling::Points;
 
-/// @brief How branch axes are estimated from one side (registration.yaml `axis_*`, `beam_*`,
-/// `silhouette_fraction`). Lengths in m.
+/// @brief How branch axes are estimated from one side (registration.yaml `axis_*`; the
+/// silhouette growth from the sensor calibration). Lengths in m.
 ///
 /// Why: a station sees only the half of each branch that faces it, and the station on the
 /// other side of the row sees the other half. Nearest points of the two halves are a diameter
@@ -28,22 +28,24 @@ struct AxisConfig {
   double min_view_agreement = 0.95;
   double min_radius = 0.003;  ///< samples outside [min, max] radius are dropped (forks, trunk)
   double max_radius = 0.04;
-  double beam_exit = 0.008;        ///< beam diameter at the optics (LMS111: 8 mm)
-  double beam_divergence = 0.015;  ///< rad, full angle (LMS111: 15 mrad)
-  /// Share of the beam footprint the silhouette grows by: a beam half on a branch still
-  /// returns (with the branch's range), so the visible width is 2r + fraction x footprint.
-  /// Depends on the sensor's detection threshold; calibrate against a pole of known diameter.
-  double silhouette_fraction = 0.3;
+  /// How much wider than its diameter a thin branch's one-sided silhouette looks: a beam
+  /// partly on a branch still returns with the branch's range, so the visible width is
+  /// 2 r + silhouette_growth_m + silhouette_growth_per_m x range. The scanner's own (its beam
+  /// and detection threshold): from the sensor calibration (calibrate_diameters on the rig's
+  /// views). 0 and 0: an ideal beam.
+  double silhouette_growth_m = 0.0;
+  double silhouette_growth_per_m = 0.0;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };
 
 /// @brief Branch-axis samples in one frame (parallel arrays).
 struct AxisSamples {
-  Points points;              ///< on the estimated axis
-  Points directions;          ///< unit axis directions (sign arbitrary)
-  Points view_dirs;           ///< unit directions towards the sensor that saw the half
-  std::vector<double> radii;  ///< m, estimated from the silhouette
+  Points points;               ///< on the estimated axis
+  Points directions;           ///< unit axis directions (sign arbitrary)
+  Points view_dirs;            ///< unit directions towards the sensor that saw the half
+  std::vector<double> radii;   ///< m, estimated from the silhouette
+  std::vector<double> ranges;  ///< m, the patch's median distance to its sensor
 
   std::size_t size() const { return points.size(); }
 };

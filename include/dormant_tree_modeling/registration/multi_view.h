@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/modeling/sensor_calibration.h"
 #include "dormant_tree_modeling/registration/branch_axes.h"
 #include "dormant_tree_modeling/registration/coarse_search.h"
 #include "dormant_tree_modeling/registration/icp.h"
@@ -35,6 +36,11 @@ struct RegistrationConfig {
 /// `registration:` section when present); missing keys keep defaults.
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR, INVALID_ARGUMENT
 RegistrationConfig loadRegistrationConfig(const std::string& path);
+
+/// @brief Take the silhouette growth of the branch axes from a sensor calibration.
+/// @return false (config unchanged: an ideal beam) when the calibration has no silhouette
+bool applySensorCalibration(const modeling::SensorCalibration& calibration,
+                            RegistrationConfig& config);
 
 /// @brief One view to register. Views of one platform position (a station) are related by
 /// exact slide moves and are registered as one rigid body.

@@ -8,6 +8,7 @@
 
 #include <condition_variable>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 
@@ -51,6 +52,8 @@ class TreeModelerNode {
   void writeFiles(const modeling::TreeModel& model, const Cloud& cloud,
                   const std_msgs::Header& header);
   void noteOutcome(bool ok, const std::string& message);
+  /// Logs each calibration warning of the models the first time it comes.
+  void warnOnce(const std::vector<std::string>& warnings);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   modeling::TreeModeler modeler_;
@@ -71,6 +74,7 @@ class TreeModelerNode {
   bool busy_ = false, last_ok_ = true;
   std::size_t models_ = 0, failures_ = 0;
   std::string last_outcome_ = "no cloud yet";
+  std::set<std::string> warned_;  // the models' calibration warnings logged so far
   std::thread worker_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "dormant_tree_modeling/common/random.h"
@@ -21,6 +22,8 @@ struct Lms111Config {
   double min_range = 0.5;                ///< m, datasheet; nearer returns are reported invalid
   double max_range = 20.0;               ///< m, datasheet (10 % reflectance)
   double range_noise_sigma = 0.012;      ///< m, 1 sigma statistical error (datasheet +/-12 mm)
+  /// Noise growing with range: sigma(d) = range_noise_sigma + this x d (m per m; 0: constant)
+  double range_noise_per_m = 0.0;
   double range_bias = 0.0;  ///< m, systematic error of this unit (datasheet: typ. within +/-30 mm)
   double beam_exit_diameter = 0.008;  ///< m at the optics cover (operating instructions 3.6.2)
   double beam_divergence = 0.015;     ///< rad, full angle (operating instructions 3.6.2)
@@ -39,6 +42,16 @@ struct Lms111Config {
   /// @brief Validate the values; @throws Error INVALID_ARGUMENT naming the bad field.
   void validate() const;
 };
+
+/// @brief A sensor whose physics differs from this model's (for worlds the modeler is only
+/// scored on): "ours" (the defaults), "thin_beam" (one ray: no footprint widening),
+/// "wide_beam" (12 mm exit, 25 mrad divergence), "far_noise" (noise growing 2 mm per metre
+/// of range, echoes merging over 1.2 m: more mixed pixels). Range noise stays the default's: set it
+/// after.
+/// @throws Error INVALID_ARGUMENT naming the known variants
+Lms111Config sensorVariant(const std::string& name);
+/// @brief The names sensorVariant() knows.
+std::vector<std::string> sensorVariantNames();
 
 /// @brief One simulated scan line, as the device would report it.
 struct ScanLine {
