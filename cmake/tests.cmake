@@ -13,7 +13,8 @@ foreach(test_source ${DTM_UNIT_TESTS})
 endforeach()
 # The tool tests run the built tools.
 if(TARGET test_tools)
-  add_dependencies(test_tools tree_model evaluate_model lms111_decode render_model)
+  add_dependencies(test_tools tree_model evaluate_model lms111_decode render_model synth_tree
+                   calibrate_diameters)
 endif()
 
 file(GLOB DTM_ROSTEST_NODES

@@ -9,6 +9,7 @@
 
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
@@ -42,6 +43,12 @@ constexpr double SLICE_MAX_FACTOR = 2.5;
 constexpr double TRUNK_TO_BRANCH = 2.5;
 constexpr double MIN_BRANCH_BOUND_M = 0.025;
 constexpr double MIN_TRUNK_RADIUS_M = 0.003;
+// The noise estimator reads thick trunk slices: a 5 cm radius stands for them.
+constexpr double ESTIMATOR_RADIUS_M = 0.05;
+constexpr double MIN_AXIS_STEP_M = 1e-5;
+// Keys of the two tables in the cache.
+constexpr int TRUNK_TABLE = 0;
+constexpr int BRANCH_TABLE = 1;
 
 /// A return on a cylinder of radius r about `axis` through the origin, seen along beam b
 /// (unit, not parallel to the axis), `lateral` across the silhouette (-1..1) and `along` the
@@ -54,29 +61,43 @@ Eigen::Vector3d rodReturn(const Eigen::Vector3d& axis, const Eigen::Vector3d& b,
   return along * axis + u * across - std::sqrt(r * r - u * u) * facing + noise * b;
 }
 
+/// A cross-section of radius r about the origin seen from VIEWS views evenly around (a random
+/// turn), its returns displaced by Gaussian noise `sigma` along their beams.
+Points2 noisySlice(double r, double sigma, Rng& rng) {
+  Points2 plane;
+  const double turn = rng.uniform(0.0, 2.0 * M_PI);
+  for (int v = 0; v < VIEWS; ++v) {
+    const double az = turn + 2.0 * M_PI * v / VIEWS;
+    const Eigen::Vector3d b(std::cos(az), std::sin(az), 0.0);
+    for (int k = 0; k < SLICE_RETURNS_PER_VIEW; ++k) {
+      const Eigen::Vector3d q = rodReturn(Eigen::Vector3d::UnitZ(), b, r, rng.uniform(-1.0, 1.0),
+                                          0.0, sigma * rng.normal());
+      plane.emplace_back(q.x(), q.y());
+    }
+  }
+  return plane;
+}
+
+/// The trunk step's circle options for a section of radius r under noise sigma.
+CircleRansacOptions sliceOptions(const ModelerConfig& config, double r, double sigma,
+                                 std::uint64_t seed) {
+  CircleRansacOptions o;
+  o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, 2.5 * sigma)
+                                              : config.circle_threshold;
+  o.iterations = config.ransac_iterations;
+  o.min_radius = std::max(MIN_TRUNK_RADIUS_M, SLICE_MIN_FACTOR * r);
+  o.max_radius = SLICE_MAX_FACTOR * r;
+  o.seed = seed;
+  return o;
+}
+
 double sliceBias(const ModelerConfig& config, double r, double sigma, std::uint64_t seed) {
   double sum = 0.0;
   int n = 0;
   for (int rep = 0; rep < REPEATS; ++rep) {
     Rng rng = Rng::derive(seed, rep);
-    Points2 plane;
-    const double turn = rng.uniform(0.0, 2.0 * M_PI);
-    for (int v = 0; v < VIEWS; ++v) {
-      const double az = turn + 2.0 * M_PI * v / VIEWS;
-      const Eigen::Vector3d b(std::cos(az), std::sin(az), 0.0);
-      for (int k = 0; k < SLICE_RETURNS_PER_VIEW; ++k) {
-        const Eigen::Vector3d q = rodReturn(Eigen::Vector3d::UnitZ(), b, r, rng.uniform(-1.0, 1.0),
-                                            0.0, sigma * rng.normal());
-        plane.emplace_back(q.x(), q.y());
-      }
-    }
-    CircleRansacOptions o;
-    o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, 2.5 * sigma)
-                                                : config.circle_threshold;
-    o.iterations = config.ransac_iterations;
-    o.min_radius = std::max(MIN_TRUNK_RADIUS_M, SLICE_MIN_FACTOR * r);
-    o.max_radius = SLICE_MAX_FACTOR * r;
-    o.seed = rng.next();
+    const Points2 plane = noisySlice(r, sigma, rng);
+    const CircleRansacOptions o = sliceOptions(config, r, sigma, rng.next());
     const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
     if (c && c->surface) {
       sum += c->circle.radius - r;
@@ -117,12 +138,47 @@ double rodBias(double r, double sigma, std::uint64_t seed) {
   return n > 0 ? sum / n : 0.0;
 }
 
-/// The table of `bias(r, sigma, seed)` over the radii and NOISE_M, all cores, seeded by cell.
+/// What the modeler's noise estimator (estimateNoiseSigma: the radial residuals of thick trunk
+/// slices) reports for returns of range noise `sigma`: the tables are looked up by it.
+double estimatedNoise(const ModelerConfig& config, double sigma, std::uint64_t seed) {
+  std::vector<double> estimates;
+  for (int rep = 0; rep < REPEATS; ++rep) {
+    Rng rng = Rng::derive(seed, rep);
+    const Points2 plane = noisySlice(ESTIMATOR_RADIUS_M, sigma, rng);
+    const CircleRansacOptions o = sliceOptions(config, ESTIMATOR_RADIUS_M, sigma, rng.next());
+    const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
+    if (!c)
+      continue;
+    std::vector<double> residuals;
+    for (const auto& q : plane) {
+      const double d = (q - c->circle.center).norm() - c->circle.radius;
+      if (std::abs(d) < 0.5 * c->circle.radius)
+        residuals.push_back(d);
+    }
+    estimates.push_back(noiseFromRadialResiduals(std::move(residuals)));
+  }
+  return estimates.empty() ? sigma : median(std::move(estimates));
+}
+
+/// The noise axis: the estimator's reading of each of NOISE_M, kept ascending.
+std::vector<double> estimatedNoiseAxis(const ModelerConfig& config, std::uint64_t seed) {
+  std::vector<double> axis(NOISE_M.size());
+  parallelFor(static_cast<int>(NOISE_M.size()), [&](int k) {
+    axis[k] = estimatedNoise(config, NOISE_M[k], Rng::derive(seed, 1000 + k).next());
+  });
+  for (std::size_t k = 1; k < axis.size(); ++k)
+    axis[k] = std::max(axis[k], axis[k - 1] + MIN_AXIS_STEP_M);
+  return axis;
+}
+
+/// The table of `bias(r, sigma, seed)` over the radii and NOISE_M, all cores, seeded by cell;
+/// its noise axis is what the modeler's estimator reads for each noise.
 template <typename Bias>
-RadiusCalibration tabulate(const std::vector<double>& radii, std::uint64_t seed, Bias bias) {
+RadiusCalibration tabulate(const ModelerConfig& config, const std::vector<double>& radii,
+                           std::uint64_t seed, Bias bias) {
   RadiusCalibration t;
   t.radii = radii;
-  t.noise = NOISE_M;
+  t.noise = estimatedNoiseAxis(config, seed);
   t.bias.assign(radii.size() * NOISE_M.size(), 0.0);
   const int cells = static_cast<int>(t.bias.size());
   parallelFor(cells, [&](int i) {
@@ -147,18 +203,20 @@ RadiusCalibration cached(const Key& key, const std::function<RadiusCalibration()
 }  // namespace
 
 RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {
-  const auto key = std::make_tuple(config.circle_threshold, config.ransac_iterations,
+  const auto key = std::make_tuple(TRUNK_TABLE, config.circle_threshold, config.ransac_iterations,
                                    config.ours_derive_parameters, config.seed);
   return cached(key, [&] {
     return tabulate(
-        TRUNK_RADII_M, config.seed * 104729ULL,
+        config, TRUNK_RADII_M, config.seed * 104729ULL,
         [&](double r, double s, std::uint64_t seed) { return sliceBias(config, r, s, seed); });
   });
 }
 
 RadiusCalibration branchNoiseBias(const ModelerConfig& config) {
-  return cached(config.seed,
-                [&] { return tabulate(BRANCH_RADII_M, config.seed * 130363ULL, rodBias); });
+  const auto key = std::make_tuple(BRANCH_TABLE, config.circle_threshold, config.ransac_iterations,
+                                   config.ours_derive_parameters, config.seed);
+  return cached(key,
+                [&] { return tabulate(config, BRANCH_RADII_M, config.seed * 130363ULL, rodBias); });
 }
 
 double footprintBiasAt(const RadiusCalibration& footprint, double radius, double sigma) {

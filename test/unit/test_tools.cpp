@@ -36,6 +36,45 @@ int run(const std::string& tool, const std::string& args, std::string* output = 
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+TEST(CalibrateDiametersTool, FromARigScanToAModelThatNamesIt) {
+  test::TempDir dir;
+  std::string out;
+  EXPECT_EQ(run("calibrate_diameters", "--scan x.pcd", &out), 2) << out;  // no --truth, no -o
+  EXPECT_EQ(run("calibrate_diameters",
+                "--scan " + dir.write("empty.xyz", "# none\n") + " --truth " +
+                    dir.file("absent.json") + " -o " + dir.file("c.yaml"),
+                &out),
+            3)
+      << out;
+  ASSERT_EQ(
+      run("synth_tree",
+          "--preset calibration_rig --noise-mm 6 --no-view-files --out " + dir.file("rig"), &out),
+      0)
+      << out;
+  ASSERT_EQ(run("calibrate_diameters",
+                "--scan " + dir.file("rig/target.pcd") + " --truth " + dir.file("rig/truth.json") +
+                    " --name unit7 -o " + dir.file("c.yaml"),
+                &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("covers: trunk radius 8.0-100.0 mm"), std::string::npos) << out;
+  ASSERT_EQ(run("tree_model",
+                dir.file("rig/target.pcd") + " -o " + dir.file("m.json") + " --calibration " +
+                    dir.file("c.yaml"),
+                &out),
+            0)
+      << out;
+  const auto model = io::readModelFile(dir.file("m.json"));
+  EXPECT_EQ(model.correction.calibration, "unit7");
+  EXPECT_EQ(model.correction.calibration_hash.size(), 16u);
+  EXPECT_EQ(run("tree_model",
+                dir.file("rig/target.pcd") + " -o " + dir.file("m.json") + " --calibration " +
+                    dir.file("absent.yaml"),
+                &out),
+            3)
+      << out;
+}
+
 TEST(TreeModelTool, ExitCodesAreDistinctAndDocumented) {
   test::TempDir dir;
   std::string out;
