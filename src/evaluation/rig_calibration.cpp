@@ -36,6 +36,8 @@ constexpr double SILHOUETTE_VOXEL_M = 0.02;
 constexpr double SILHOUETTE_NEAR_ROD_M = 0.05;
 constexpr double SILHOUETTE_OUTLIER_SIGMAS = 2.5;
 constexpr double MIN_RANGE_SPREAD_M = 0.2;  // narrower: the growth is taken as constant
+constexpr double MAX_DEPTH_SHARE = 1.5;
+constexpr int DEPTH_SHARE_STEPS = 7;  // 1.5 / 2^7: about 1 % of the growth
 
 struct Section {
   int index = 0;
@@ -348,20 +350,22 @@ bool nearARod(const Eigen::Vector3d& p, const GroundTruth& rig) {
   return false;
 }
 
-struct GrowthSample {
-  double range, growth;
+/// One station's (one side's) returns near the rods, in the rig's frame, and where axis
+/// samples are tried (2 cm voxels of them).
+struct StationPoints {
+  modeling::Points pts, dirs, centres;
+  std::vector<double> ranges;
+  int rig = 0;  // index of its rig
 };
 
-/// Per station (one side of the rig), the registration's axis samples on the rods with no
-/// growth taken off: twice their radius less the rod's diameter is the silhouette's growth.
-std::vector<GrowthSample> silhouetteSamples(const RigScan& scan, const RigSearch& search) {
-  std::map<int, std::vector<const registration::ViewInput*>> stations;
+std::vector<StationPoints> rigStations(const RigScan& scan, int rig_index) {
+  std::map<int, std::vector<const registration::ViewInput*>> by_station;
   for (const auto& v : scan.views)
-    stations[v.station].push_back(&v);
-  std::vector<GrowthSample> out;
-  for (const auto& [id, views] : stations) {
-    modeling::Points pts, dirs, centres;
-    std::vector<double> ranges;
+    by_station[v.station].push_back(&v);
+  std::vector<StationPoints> out;
+  for (const auto& [id, views] : by_station) {
+    StationPoints s;
+    s.rig = rig_index;
     std::unordered_map<long long, char> voxels;
     for (const auto* v : views) {
       const Eigen::Vector3d sensor = v->in_station * v->sensor;
@@ -370,25 +374,49 @@ std::vector<GrowthSample> silhouetteSamples(const RigScan& scan, const RigSearch
         if (!q.allFinite() || !nearARod(q, scan.rig))
           continue;
         const Eigen::Vector3d d = sensor - q;
-        pts.push_back(q);
-        ranges.push_back(d.norm());
-        dirs.push_back(d.normalized());
+        s.pts.push_back(q);
+        s.ranges.push_back(d.norm());
+        s.dirs.push_back(d.normalized());
         const Eigen::Array3d cell = (q / SILHOUETTE_VOXEL_M).array().floor();
         const long long key = (static_cast<long long>(cell.x()) * 73856093LL) ^
                               (static_cast<long long>(cell.y()) * 19349663LL) ^
                               (static_cast<long long>(cell.z()) * 83492791LL);
         if (voxels.emplace(key, 1).second)
-          centres.push_back(q);
+          s.centres.push_back(q);
       }
     }
-    const auto axes =
-        registration::estimateAxes(pts, dirs, ranges, centres, registration::AxisConfig{});
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+/// Each axis sample on a rod, as the registration estimates it with `axes`: its range, its
+/// silhouette's growth (twice its radius less the rod's diameter, meaningful with no growth
+/// taken off) and its depth error (signed, towards the sensor: m).
+struct AxisSampleOnRod {
+  double range, growth, depth_error;
+};
+
+std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& stations,
+                                           const std::vector<GroundTruth>& rigs,
+                                           const RigSearch& search,
+                                           const registration::AxisConfig& axes_config) {
+  std::vector<AxisSampleOnRod> out;
+  for (const auto& s : stations) {
+    const GroundTruth& rig = rigs[s.rig];
+    const auto axes = registration::estimateAxes(s.pts, s.dirs, s.ranges, s.centres, axes_config);
     for (std::size_t i = 0; i < axes.size(); ++i) {
-      const int rod = rodOf(axes.points[i], axes.directions[i], scan.rig, search);
-      if (rod >= 0) {
-        out.push_back({axes.ranges[i],
-                       2.0 * axes.radii[i] - scan.rig.primary_branches[rod].diameters.front()});
-      }
+      const int k = rodOf(axes.points[i], axes.directions[i], rig, search);
+      if (k < 0)
+        continue;
+      const auto& rod = rig.primary_branches[k];
+      const Eigen::Vector3d dir = (rod.points.back() - rod.points.front()).normalized();
+      const Eigen::Vector3d w = axes.points[i] - rod.points.front();
+      const Eigen::Vector3d off = w - w.dot(dir) * dir;
+      Eigen::Vector3d towards = axes.view_dirs[i] - axes.view_dirs[i].dot(dir) * dir;
+      towards.normalize();
+      out.push_back(
+          {axes.ranges[i], 2.0 * axes.radii[i] - rod.diameters.front(), off.dot(towards)});
     }
   }
   return out;
@@ -396,7 +424,7 @@ std::vector<GrowthSample> silhouetteSamples(const RigScan& scan, const RigSearch
 
 /// growth = a + b range by least squares, refitted without the samples beyond 2.5 robust
 /// sigmas of the first fit; b = 0 when the ranges hardly vary.
-modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<GrowthSample>& samples) {
+modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOnRod>& samples) {
   modeling::SensorCalibration::Silhouette s;
   s.measured = true;
   std::vector<double> r;
@@ -428,6 +456,29 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<GrowthSample
       keep[i] = residuals[i] <= SILHOUETTE_OUTLIER_SIGMAS * sigma;
   }
   return s;
+}
+
+/// The share of the silhouette growth the registration takes off so that its axes lie at the
+/// rods' depth: the footprint's wings widen the silhouette but carry the near surface's range,
+/// so the depth model wants less than the whole widening. Bisection on the median depth error,
+/// which falls as the share grows (a smaller radius puts the axis nearer the surface).
+double depthShare(const std::vector<StationPoints>& stations, const std::vector<GroundTruth>& rigs,
+                  const RigSearch& search, const modeling::SensorCalibration::Silhouette& growth) {
+  auto error = [&](double share) {
+    registration::AxisConfig c;
+    c.silhouette_growth_m = share * growth.growth_m;
+    c.silhouette_growth_per_m = share * growth.growth_per_m;
+    std::vector<double> e;
+    for (const auto& s : samplesOnRods(stations, rigs, search, c))
+      e.push_back(s.depth_error);
+    return e.empty() ? 0.0 : median(e);
+  };
+  double lo = 0.0, hi = MAX_DEPTH_SHARE;
+  for (int it = 0; it < DEPTH_SHARE_STEPS; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (error(mid) > 0.0 ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 }  // namespace
@@ -486,7 +537,8 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   const auto branch_noise = modeling::branchNoiseBias(raw);
   RigCalibrationResult result;
   std::vector<double> sigmas;
-  std::vector<GrowthSample> silhouette;
+  std::vector<StationPoints> stations;
+  std::vector<GroundTruth> rigs;
   bool with_views = false;
   for (RigScan scan : scans) {
     if (scan.points.empty())
@@ -509,8 +561,9 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
     result.samples.insert(result.samples.end(), sections.begin(), sections.end());
     result.samples.insert(result.samples.end(), rods.begin(), rods.end());
     sigmas.push_back(sigma);
-    const auto growth = silhouetteSamples(scan, search);
-    silhouette.insert(silhouette.end(), growth.begin(), growth.end());
+    const auto sides = rigStations(scan, static_cast<int>(rigs.size()));
+    stations.insert(stations.end(), sides.begin(), sides.end());
+    rigs.push_back(scan.rig);
     with_views = with_views || !scan.views.empty();
     result.calibration.sources.push_back(scan.name);
   }
@@ -525,8 +578,10 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   c.coverage.noise_max_m = rows.back();
   c.trunk_footprint = footprintTable(result.samples, true, rows);
   c.branch_footprint = footprintTable(result.samples, false, rows);
+  const auto silhouette = samplesOnRods(stations, rigs, search, registration::AxisConfig{});
   if (silhouette.size() >= static_cast<std::size_t>(search.min_silhouette_samples)) {
     c.silhouette = fitGrowth(silhouette);
+    c.silhouette.depth_share = depthShare(stations, rigs, search, c.silhouette);
   } else {
     result.warnings.push_back(
         with_views ? "only " + std::to_string(silhouette.size()) +

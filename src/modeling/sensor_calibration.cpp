@@ -158,7 +158,7 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   std::tie(c.coverage.noise_min_m, c.coverage.noise_max_m) = range(covers, "noise_m", path);
   if (root["silhouette"]) {
     const YAML::Node s =
-        section(root, "silhouette", {"growth_m", "growth_per_m", "ranges_m"}, path);
+        section(root, "silhouette", {"growth_m", "growth_per_m", "ranges_m", "depth_share"}, path);
     const auto growth = numbers(s, "growth_m", "silhouette", path);
     const auto per_m = numbers(s, "growth_per_m", "silhouette", path);
     const auto ranges = numbers(s, "ranges_m", "silhouette", path);
@@ -168,7 +168,11 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
       fail(ErrorCode::INVALID_ARGUMENT, path,
            "silhouette: growth_m and growth_per_m are [one number] within +/-0.05, ranges_m is "
            "[min, max]");
-    c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1]};
+    const auto share =
+        s["depth_share"] ? numbers(s, "depth_share", "silhouette", path) : std::vector<double>{1.0};
+    if (share.size() != 1 || !(share[0] >= 0.0 && share[0] <= 2.0))
+      fail(ErrorCode::INVALID_ARGUMENT, path, "silhouette: depth_share is [one number] in [0, 2]");
+    c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1], share[0]};
   }
   c.hash = fnv1aHex(text.str());
   return c;
@@ -194,7 +198,8 @@ std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::strin
   if (c.silhouette.measured) {
     s << "  silhouette:\n    growth_m: " << list({c.silhouette.growth_m})
       << "\n    growth_per_m: " << list({c.silhouette.growth_per_m})
-      << "\n    ranges_m: " << list({c.silhouette.range_min_m, c.silhouette.range_max_m}) << "\n";
+      << "\n    ranges_m: " << list({c.silhouette.range_min_m, c.silhouette.range_max_m})
+      << "\n    depth_share: " << list({c.silhouette.depth_share}) << "\n";
   }
   return s.str();
 }

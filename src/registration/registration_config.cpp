@@ -94,8 +94,9 @@ bool applySensorCalibration(const modeling::SensorCalibration& calibration,
                             RegistrationConfig& config) {
   if (!calibration.silhouette.measured)
     return false;
-  config.axes.silhouette_growth_m = calibration.silhouette.growth_m;
-  config.axes.silhouette_growth_per_m = calibration.silhouette.growth_per_m;
+  const auto& s = calibration.silhouette;
+  config.axes.silhouette_growth_m = s.depth_share * s.growth_m;
+  config.axes.silhouette_growth_per_m = s.depth_share * s.growth_per_m;
   return true;
 }
 

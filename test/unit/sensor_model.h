@@ -4,6 +4,7 @@
 
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/sensor_calibration.h"
+#include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
 namespace test {
@@ -15,6 +16,13 @@ inline modeling::ModelerConfig sensorModelConfig() {
   modeling::ModelerConfig c;
   c.calibration = modeling::loadSensorCalibration(std::string(DTM_CONFIG_DIR) +
                                                   "/calibration/lms111_model.yaml");
+  return c;
+}
+
+/// @brief The registration's defaults with the silhouette growth of that calibration.
+inline registration::RegistrationConfig sensorModelRegistrationConfig() {
+  registration::RegistrationConfig c;
+  registration::applySensorCalibration(sensorModelConfig().calibration, c);
   return c;
 }
 

@@ -66,7 +66,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   c.trunk_footprint.bias = {0.003, 0.001};
   c.branch_footprint = c.trunk_footprint;
   c.coverage = {0.01, 0.05, 0.003, 0.02, 0.006, 0.006};
-  c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4};
+  c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4, 0.5};
   const std::string path =
       dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "made by a test"));
   const auto back = modeling::loadSensorCalibration(path);
@@ -79,7 +79,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_DOUBLE_EQ(back.silhouette.growth_per_m, 0.0085);
   registration::RegistrationConfig reg;
   EXPECT_TRUE(registration::applySensorCalibration(back, reg));
-  EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.0015);
+  EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.5 * 0.0015);
   modeling::SensorCalibration without = back;
   without.silhouette = {};
   registration::RegistrationConfig ideal;
@@ -201,6 +201,9 @@ TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
   EXPECT_LT(at_2m, 0.030);
   EXPECT_GT(s.growth_per_m, 0.0);
   EXPECT_LT(s.range_min_m, 1.6);
+  // The wings carry the near surface's range: the axes' depth wants part of the growth only.
+  EXPECT_GT(s.depth_share, 0.3);
+  EXPECT_LT(s.depth_share, 0.9);
   // The same rig as a cloud cannot tell the sides apart: said, and nothing measured.
   const auto cloud = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
   EXPECT_FALSE(cloud.calibration.silhouette.measured);

@@ -35,6 +35,9 @@ struct SensorCalibration {
     bool measured = false;
     double growth_m = 0.0, growth_per_m = 0.0;
     double range_min_m = 0.0, range_max_m = 0.0;  ///< the ranges the rig's rods were seen at
+    /// The share of the growth the registration takes off a silhouette so that its axes lie
+    /// at the rods' depth (the footprint's wings carry the near surface's range).
+    double depth_share = 1.0;
   } silhouette;
   std::vector<std::string> sources;  ///< the scans it was made from, for the record
 
