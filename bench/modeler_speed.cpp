@@ -48,8 +48,13 @@ Cloud crop(std::size_t n) {
 }
 
 void runModel(benchmark::State& state, const Cloud& input, bool ours) {
-  const modeling::TreeModeler modeler(ours ? modeling::ModelerConfig{}
-                                           : modeling::ModelerConfig::paper());
+  modeling::ModelerConfig config = modeling::ModelerConfig::paper();
+  if (ours) {
+    config = modeling::ModelerConfig{};
+    config.calibration = modeling::loadSensorCalibration(std::string(DTM_CONFIG_DIR) +
+                                                         "/calibration/lms111_model.yaml");
+  }
+  const modeling::TreeModeler modeler(config);
   std::size_t branches = 0;
   for (auto _ : state) {
     try {
