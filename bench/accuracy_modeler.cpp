@@ -6,7 +6,8 @@
 // world's own rig scan (synth_tree --preset calibration_rig, calibrate_diameters); the paper's
 // method on our world as the baseline. Scored with docs/evaluation.md.
 // Our world has the tuning trees (seeds 100..) the defaults were chosen on and held-out ones;
-// the variant worlds have held-out trees only: they are scored, never tuned on.
+// the variant worlds have held-out trees only, and our world also scores tree variants
+// (crooked leader, drooping or steep scaffolds, sparse or dense whorls): never tuned on.
 // Usage: accuracy_modeler [--trees N (tuning, per preset, default 4)] [--held-out N (default 4)]
 //                         [--variant-trees N (per preset, default 2)] [--out DIR]
 //                         [--noise-mm a,b,c] [--worlds ours,thin_beam,wide_beam,far_noise]
@@ -24,6 +25,7 @@
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/simulation/calibration_rig.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
+#include "dormant_tree_modeling/simulation/tree_generator.h"
 
 using namespace dormant_tree_modeling;
 
@@ -173,15 +175,19 @@ int main(int argc, char** argv) {
       struct Set {
         const char* name;
         int first, count;
+        std::vector<std::string> presets;
       };
       const std::vector<Set> sets =
-          ours ? std::vector<Set>{{"tuning", 0, opt.tuning}, {"held-out", opt.tuning, opt.held_out}}
-               : std::vector<Set>{{"scored", opt.tuning, opt.variant_trees}};
+          ours ? std::vector<Set>{{"tuning", 0, opt.tuning, PRESETS},
+                                  {"held-out", opt.tuning, opt.held_out, PRESETS},
+                                  {"tree-var", opt.tuning, opt.variant_trees,
+                                   simulation::variantPresetNames()}}
+               : std::vector<Set>{{"scored", opt.tuning, opt.variant_trees, PRESETS}};
       for (const Set& set : sets) {
         if (set.count <= 0)
           continue;
         std::vector<std::vector<evaluation::TreeScore>> scores(ms.size());
-        for (const auto& preset : PRESETS) {
+        for (const auto& preset : set.presets) {
           for (int k = set.first; k < set.first + set.count; ++k) {
             char name[160];
             std::snprintf(name, sizeof(name), "%s/%s/%s_%02d_%gmm", opt.out.c_str(), world.c_str(),

@@ -1,3 +1,4 @@
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,51 @@ namespace simulation {
 std::vector<std::string> presetNames() {
   return {"young_tall_spindle", "mature_tall_spindle", "central_leader"};
 }
+
+std::vector<std::string> variantPresetNames() {
+  return {"crooked_leader", "drooping_scaffolds", "steep_scaffolds", "sparse_whorls",
+          "dense_whorls"};
+}
+
+namespace {
+
+/// Trees the modeler is only scored on: the young tall spindle with one trait pushed.
+std::optional<TreeParams> variantParams(const std::string& name) {
+  TreeParams p;
+  p.preset = name;
+  if (name == "crooked_leader") {
+    p.bend_amplitude_max = 0.15;  // the leader sways up to 15 cm off its line
+    p.lean_max_deg = 10.0;
+    return p;
+  }
+  if (name == "drooping_scaffolds") {
+    p.droop_deg_per_m = 70.0;
+    p.branch_length_min = 0.5;
+    p.branch_length_max = 1.3;
+    return p;
+  }
+  if (name == "steep_scaffolds") {
+    p.elevation_min_deg = 30.0;
+    p.elevation_max_deg = 70.0;
+    p.branch_length_min = 0.6;
+    p.branch_length_max = 1.4;
+    p.droop_deg_per_m = 5.0;
+    return p;
+  }
+  if (name == "sparse_whorls") {
+    p.primaries_min = 6;
+    p.primaries_max = 10;
+    return p;
+  }
+  if (name == "dense_whorls") {
+    p.primaries_min = 45;
+    p.primaries_max = 60;
+    return p;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 TreeParams presetParams(const std::string& name) {
   TreeParams p;
@@ -62,9 +108,13 @@ TreeParams presetParams(const std::string& name) {
     p.spurs_per_m = 3.0;
     return p;
   }
+  if (const auto v = variantParams(name))
+    return *v;
   std::string names;
   for (const auto& n : presetNames())
     names += (names.empty() ? "" : ", ") + n;
+  for (const auto& n : variantPresetNames())
+    names += ", " + n;
   throw Error(ErrorCode::INVALID_ARGUMENT,
               "unknown tree preset '" + name + "' (known: " + names + ")");
 }

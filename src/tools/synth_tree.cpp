@@ -20,7 +20,9 @@ int main(int argc, char** argv) {
       "preview.png");
   desc.add_options()("help,h", "this help")(
       "preset", po::value(&opt.orchard.preset)->default_value(opt.orchard.preset),
-      "young_tall_spindle | mature_tall_spindle | central_leader | calibration_rig (pipe sections "
+      "young_tall_spindle | mature_tall_spindle | central_leader; scored-only variants "
+      "crooked_leader | drooping_scaffolds | steep_scaffolds | sparse_whorls | dense_whorls; "
+      "calibration_rig (pipe sections "
       "and rods of known diameters; truth.json is its RIG.json for calibrate_diameters)")(
       "seed", po::value(&opt.seed)->default_value(opt.seed), "random seed")(
       "out", po::value(&out)->required(), "output directory (created)")(

@@ -42,6 +42,10 @@ TreeParams presetParams(const std::string& name);
 /// @brief The names presetParams() accepts.
 std::vector<std::string> presetNames();
 
+/// @brief Tree variants for scoring only (never tuned on): the young tall spindle with a
+/// crooked leader, drooping or long steep scaffolds, sparse or dense whorls.
+std::vector<std::string> variantPresetNames();
+
 /// @brief Generate one dormant tree whose trunk starts at `base` on the ground.
 /// @param params shape ranges
 /// @param seed equal seeds give equal trees
