@@ -1,12 +1,12 @@
 #include "dormant_tree_modeling/evaluation/rig_calibration.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
-
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <map>
 #include <unordered_map>
 
 #include "dormant_tree_modeling/common/error.h"
@@ -316,25 +316,13 @@ void checkCoverage(const std::vector<RigSample>& samples, bool trunk, const char
   }
 }
 
-/// Distance from p to the segment a-b and the segment's unit direction.
-double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                       Eigen::Vector3d* direction) {
-  const Eigen::Vector3d d = b - a;
-  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  *direction = d.normalized();
-  return (p - (a + t * d)).norm();
-}
-
 /// The rod whose axis a silhouette sample lies on, or -1.
 int rodOf(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const GroundTruth& rig,
           const RigSearch& search) {
   const double min_cos = std::cos(search.max_silhouette_angle_deg * M_PI / 180.0);
   for (std::size_t k = 0; k < rig.primary_branches.size(); ++k) {
-    const auto& pts = rig.primary_branches[k].points;
-    Eigen::Vector3d rod_dir;
-    if (pts.size() >= 2 &&
-        segmentDistance(p, pts.front(), pts.back(), &rod_dir) < search.silhouette_reach_m &&
-        std::abs(rod_dir.dot(dir)) >= min_cos)
+    const PolylinePoint q = closestPoint(rig.primary_branches[k], p);
+    if (q.distance < search.silhouette_reach_m && std::abs(q.direction.dot(dir)) >= min_cos)
       return static_cast<int>(k);
   }
   return -1;
@@ -342,9 +330,7 @@ int rodOf(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const GroundTrut
 
 bool nearARod(const Eigen::Vector3d& p, const GroundTruth& rig) {
   for (const auto& rod : rig.primary_branches) {
-    Eigen::Vector3d dir;
-    if (rod.points.size() >= 2 && segmentDistance(p, rod.points.front(), rod.points.back(), &dir) <
-                                      0.5 * rod.diameters.front() + SILHOUETTE_NEAR_ROD_M)
+    if (closestPoint(rod, p).distance < 0.5 * rod.diameters.front() + SILHOUETTE_NEAR_ROD_M)
       return true;
   }
   return false;
