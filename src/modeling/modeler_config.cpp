@@ -50,6 +50,7 @@ const std::map<std::string, Setter>& setters() {
   using C = ModelerConfig;
   static const std::map<std::string, Setter> table = {
       {"voxel_size", setter(&C::voxel_size)},
+      {"max_modeled_points", setter(&C::max_modeled_points)},
       {"cluster_points", setter(&C::cluster_points)},
       {"split_error", setter(&C::split_error)},
       {"merge_distance", setter(&C::merge_distance)},
@@ -129,6 +130,7 @@ ModelerConfig ModelerConfig::paper() {
 
 void ModelerConfig::validate() const {
   check("voxel_size", voxel_size, 0.0, 0.05);
+  check("max_modeled_points", max_modeled_points, 10000, 50000000);
   check("cluster_points", cluster_points, 50, 1000000);
   check("split_error", split_error, 1e-4, 0.1);
   check("merge_distance", merge_distance, 0.0, 1.0);

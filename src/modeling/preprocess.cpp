@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
@@ -26,6 +27,10 @@ constexpr double GROUND_BAND = 0.03;          // m above the ground plane remove
 constexpr double GROUND_MIN_EXTENT = 0.8;     // m: a plane smaller than this is not the ground
 constexpr std::size_t GROUND_SAMPLE = 50000;  // low points that score a ground hypothesis
 constexpr double SPACING_CELL = 0.02;         // m, grid of medianSpacing() without an index
+// Above max_modeled_points the grid grows by at least this factor per round, from at least
+// MIN_CAPPED_VOXEL_M (a configured voxel_size of 0 keeps every point until the cap).
+constexpr double MIN_VOXEL_GROWTH = 1.25;
+constexpr double MIN_CAPPED_VOXEL_M = 0.001;
 // Far outliers: the bulk's box is the 1st to 99th percentile on each axis (from a sample of
 // at most FAR_OUTLIER_SAMPLE points); a point more than FAR_OUTLIER_MARGIN box extents (and at
 // least FAR_OUTLIER_MIN_MARGIN_M) outside it is a stray, not a part of an orchard scene.
@@ -41,6 +46,21 @@ constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr double WIRE_MAX_CROSSING = 10.0 * M_PI / 180.0;  // from the row's direction
 constexpr int MAX_WIRES = 10;
 constexpr double WIRE_TEST_VOXEL = 0.01;  // m
+
+/// Downsamples pts again on coarser grids until at most `cap` are left.
+/// @param voxel the grid pts were downsampled on (m); receives the grid used
+/// @returns how many points the coarser grids merged away
+std::size_t capPoints(Points& pts, std::size_t cap, double* voxel) {
+  const std::size_t before = pts.size();
+  while (pts.size() > cap) {
+    // A scanned surface's count falls with the square of the grid; a cloud filling a volume
+    // falls faster, so the loop ends within a few rounds either way.
+    const double shrink = std::sqrt(static_cast<double>(pts.size()) / static_cast<double>(cap));
+    *voxel = std::max(*voxel, MIN_CAPPED_VOXEL_M) * std::max(shrink, MIN_VOXEL_GROWTH);
+    pts = voxelDownsample(pts, *voxel);
+  }
+  return before - pts.size();
+}
 
 /// Removes points near a near-horizontal plane at the bottom of the cloud, if it is large.
 std::size_t removeGround(Points& pts, std::uint64_t seed) {
@@ -329,23 +349,36 @@ std::vector<char> floatingMaskWith(const Points& pts, double radius, int min_nei
   return mask;
 }
 
+/// True for a point outside the bulk's box by more than the far-outlier margin.
+class FarOutlierTest {
+ public:
+  explicit FarOutlierTest(const Points& pts) {
+    Eigen::Vector3d lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      std::vector<double> sample = axisSample(pts, a, FAR_OUTLIER_SAMPLE);
+      lo(a) = quantileInPlace(sample, FAR_OUTLIER_QUANTILE);
+      hi(a) = quantileInPlace(sample, 1.0 - FAR_OUTLIER_QUANTILE);
+    }
+    const Eigen::Vector3d margin =
+        (FAR_OUTLIER_MARGIN * (hi - lo))
+            .cwiseMax(Eigen::Vector3d::Constant(FAR_OUTLIER_MIN_MARGIN_M));
+    min_ = lo - margin;
+    max_ = hi + margin;
+  }
+  bool operator()(const Eigen::Vector3d& p) const {
+    return (p.array() < min_.array()).any() || (p.array() > max_.array()).any();
+  }
+
+ private:
+  Eigen::Vector3d min_, max_;
+};
+
 }  // namespace
 
 std::size_t removeFarOutliers(Points& pts) {
   if (pts.size() < 2)
     return 0;
-  Eigen::Vector3d lo, hi;
-  for (int a = 0; a < 3; ++a) {
-    std::vector<double> sample = axisSample(pts, a, FAR_OUTLIER_SAMPLE);
-    lo(a) = quantileInPlace(sample, FAR_OUTLIER_QUANTILE);
-    hi(a) = quantileInPlace(sample, 1.0 - FAR_OUTLIER_QUANTILE);
-  }
-  const Eigen::Vector3d margin = (FAR_OUTLIER_MARGIN * (hi - lo))
-                                     .cwiseMax(Eigen::Vector3d::Constant(FAR_OUTLIER_MIN_MARGIN_M));
-  const Eigen::Vector3d min = lo - margin, max = hi + margin;
-  const auto far = [&](const Eigen::Vector3d& p) {
-    return (p.array() < min.array()).any() || (p.array() > max.array()).any();
-  };
+  const FarOutlierTest far(pts);
   const std::size_t before = pts.size();
   pts.erase(std::remove_if(pts.begin(), pts.end(), far), pts.end());
   return before - pts.size();
@@ -397,9 +430,19 @@ std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbo
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats) {
   PreprocessStats s;
   s.input = pts.size();
-  Points bulk = pts;
-  s.far_outliers = removeFarOutliers(bulk);
-  Points out = voxelDownsample(bulk, config.voxel_size);
+  // The bulk is copied only when there are strays to drop: a whole scan is hundreds of MB.
+  Points bulk;
+  if (pts.size() >= 2) {
+    const FarOutlierTest far(pts);
+    s.far_outliers = static_cast<std::size_t>(std::count_if(pts.begin(), pts.end(), far));
+    if (s.far_outliers > 0) {
+      bulk.reserve(pts.size() - s.far_outliers);
+      std::remove_copy_if(pts.begin(), pts.end(), std::back_inserter(bulk), far);
+    }
+  }
+  s.voxel_size = config.voxel_size;
+  Points out = voxelDownsample(s.far_outliers > 0 ? bulk : pts, s.voxel_size);
+  Points().swap(bulk);
   s.after_voxel = out.size();
   if (config.ours_remove_clutter) {
     double radius = config.floating_radius;
@@ -426,6 +469,7 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
     s.ground = removeGround(out, config.seed + 11);
     s.wires = removeWires(out, config.wire_min_length, config.seed + 13, &s.wire_directions);
   }
+  s.capped = capPoints(out, static_cast<std::size_t>(config.max_modeled_points), &s.voxel_size);
   if (stats)
     *stats = s;
   return out;

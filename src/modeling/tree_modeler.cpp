@@ -18,6 +18,7 @@
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
+#include "dormant_tree_modeling/modeling/structure.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
 namespace dormant_tree_modeling {
@@ -26,6 +27,16 @@ namespace modeling {
 namespace {
 
 constexpr std::size_t MIN_POINTS = 100;
+// The structure test: neighbour growth from 5 to 10 cm (above every scanner's range noise,
+// below a trunk's length) on 2000 points.
+constexpr double STRUCTURE_RADIUS_M = 0.05;
+constexpr std::size_t STRUCTURE_SAMPLES = 2000;
+// Halfway between a surface (2) and a volume (3): trees measure 1.7-2.0, a cloud of noise 3.
+constexpr double MAX_STRUCTURE_DIMENSION = 2.5;
+// A trunk whose returns scatter more than this about its fit is not a scanned surface: four
+// times the LMS111's specified 1-sigma statistical error, and more than a young branch's
+// radius, so no diameter would mean anything.
+constexpr double MAX_NOISE_SIGMA_M = 0.05;
 constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
 constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
@@ -389,13 +400,17 @@ ModelResult TreeModeler::model(const Points& input) const {
                 "cloud has " + std::to_string(finite) + " finite points; at least " +
                     std::to_string(MIN_POINTS) + " are needed to model a tree");
   }
+  // A copy only when there is something to drop: a whole scan is hundreds of MB.
   Points clean;
-  clean.reserve(finite);
-  for (const auto& p : input) {
-    if (p.allFinite())
-      clean.push_back(p);
+  if (finite < input.size()) {
+    clean.reserve(finite);
+    for (const auto& p : input) {
+      if (p.allFinite())
+        clean.push_back(p);
+    }
   }
-  result.points = preprocess(clean, config_, &result.preprocess);
+  result.points = preprocess(finite < input.size() ? clean : input, config_, &result.preprocess);
+  Points().swap(clean);
   const Points& pts = result.points;
   watch.lap("preprocess");
   if (pts.size() < MIN_POINTS) {
@@ -406,7 +421,19 @@ ModelResult TreeModeler::model(const Points& input) const {
   // One index of the modeled cloud for the spacing, the graph, the trunk tracking and the
   // branch step.
   const PointIndex index(pts);
+  result.structure_dimension =
+      neighbourGrowthDimension(pts, index, STRUCTURE_RADIUS_M, STRUCTURE_SAMPLES);
   watch.lap("index");
+  if (result.structure_dimension > MAX_STRUCTURE_DIMENSION) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "no tree found: the points fill a volume instead of lying on surfaces "
+                  "(neighbour growth dimension %.2f over %.0f-%.0f cm, above %.1f; scanned trees "
+                  "give 1.7-2.0, noise 3)",
+                  result.structure_dimension, 100 * STRUCTURE_RADIUS_M, 200 * STRUCTURE_RADIUS_M,
+                  MAX_STRUCTURE_DIMENSION);
+    throw Error(ErrorCode::NO_TRUNK, text);
+  }
   // Algorithm 2.
   auto clusters = initialClusters(pts, config_, medianSpacing(pts, index));
 
@@ -486,6 +513,14 @@ ModelResult TreeModeler::model(const Points& input) const {
 
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
+  if (trunk.noise_sigma > MAX_NOISE_SIGMA_M) {
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  "no tree found: the returns around the best trunk candidate scatter %.0f mm "
+                  "(1 sigma) about its fit, over %.0f mm: no scanned surface",
+                  1000 * trunk.noise_sigma, 1000 * MAX_NOISE_SIGMA_M);
+    throw Error(ErrorCode::NO_TRUNK, text);
+  }
   const auto branches = modelBranches(pts, index, trunk, region, config_, &result.rejected_branches,
                                       result.preprocess.wire_directions);
   watch.lap("branches");

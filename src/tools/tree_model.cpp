@@ -75,6 +75,12 @@ int main(int argc, char** argv) {
       std::cerr << "tree_model: dropped " << cloud.dropped_non_finite << " NaN/Inf points\n";
     }
     const auto result = modeler.model(*cloud.cloud);
+    if (result.preprocess.capped > 0) {
+      std::cerr << "tree_model: warning: " << result.points.size() << " points modeled on a "
+                << 1000.0 * result.preprocess.voxel_size
+                << " mm grid, coarser than voxel_size, to stay within max_modeled_points ("
+                << config.max_modeled_points << ")\n";
+    }
     if (result.preprocess.far_outliers > 0) {
       std::cerr << "tree_model: dropped " << result.preprocess.far_outliers
                 << " stray points far outside the cloud's bulk\n";
@@ -89,8 +95,14 @@ int main(int argc, char** argv) {
     if (vm.count("verbose")) {
       std::cerr << "tree_model: " << result.points.size() << " points modeled, noise sigma "
                 << 1000.0 * result.noise_sigma << " mm, e_t " << 1000.0 * result.split_error
-                << " mm, " << result.clusters << " clusters (" << result.trunk_clusters
-                << " trunk, " << result.primary_clusters << " primary)\n";
+                << " mm, structure dimension " << result.structure_dimension << ", "
+                << result.clusters << " clusters (" << result.trunk_clusters << " trunk, "
+                << result.primary_clusters << " primary)\n";
+      const auto& pre = result.preprocess;
+      std::cerr << "  preprocessing: " << pre.input << " points, " << pre.far_outliers
+                << " far outliers, " << pre.after_voxel << " after downsampling, then dropped "
+                << pre.floating << " floating, " << pre.ground << " ground, " << pre.wires
+                << " on wires, " << pre.capped << " merged by a coarser grid\n";
       for (const auto& t : result.timings)
         std::cerr << "  " << t.first << ": " << t.second << " s\n";
       std::map<std::string, int> reasons;

@@ -8,6 +8,7 @@
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/preprocess.h"
+#include "dormant_tree_modeling/modeling/structure.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -147,6 +148,51 @@ TEST(Preprocess, AStrayPointFarFromTheTreeIsDroppedAndCountedNotFatal) {
   EXPECT_EQ(out, preprocess(kept, config, nullptr));
   Points tidy = clean;
   EXPECT_EQ(removeFarOutliers(tidy), 0u) << "a cloud without strays keeps every point";
+}
+
+TEST(Preprocess, AboveMaxModeledPointsACoarserGridKeepsTheCloudWithinIt) {
+  Rng rng(8);
+  Points wall;  // a scanned surface, 2 x 2 m at 2 mm: 1e6 cells, 40000 points
+  for (int i = 0; i < 40000; ++i)
+    wall.emplace_back(rng.uniform(0.0, 2.0), 0.001 * rng.normal(), rng.uniform(0.0, 2.0));
+  ModelerConfig config;
+  config.ours_remove_clutter = false;
+  config.voxel_size = 0.002;
+  PreprocessStats stats;
+  EXPECT_EQ(preprocess(wall, config, &stats).size(), stats.after_voxel);
+  EXPECT_EQ(stats.capped, 0u) << "within the cap: the configured grid only";
+  EXPECT_DOUBLE_EQ(stats.voxel_size, 0.002);
+  config.max_modeled_points = 10000;
+  const Points capped = preprocess(wall, config, &stats);
+  EXPECT_LE(capped.size(), 10000u);
+  EXPECT_GT(capped.size(), 5000u) << "one coarser grid, not a collapse";
+  EXPECT_EQ(stats.capped, stats.after_voxel - capped.size());
+  EXPECT_GT(stats.voxel_size, 0.002);
+  config.max_modeled_points = 10;
+  EXPECT_THROW(config.validate(), Error) << "a cap below any tree is refused";
+}
+
+TEST(NeighbourGrowthDimension, LinesSurfacesAndVolumesReadOneTwoAndThree) {
+  Rng rng(9);
+  Points line, surface, volume;
+  for (int i = 0; i < 4000; ++i)  // a wire: 2 m, 3 mm noise
+    line.emplace_back(rng.uniform(0.0, 2.0), 0.003 * rng.normal(), 0.003 * rng.normal());
+  for (int i = 0; i < 40000; ++i)  // a trunk's bark: r 10 cm, 1 m tall, 3 mm noise
+  {
+    const double a = rng.uniform(0.0, 2.0 * M_PI), r = 0.10 + 0.003 * rng.normal();
+    surface.emplace_back(r * std::cos(a), r * std::sin(a), rng.uniform(0.0, 1.0));
+  }
+  for (int i = 0; i < 40000; ++i)  // noise filling 1 m^3
+    volume.emplace_back(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0));
+  const auto dimension = [](const Points& pts) {
+    const PointIndex index(pts);
+    return neighbourGrowthDimension(pts, index, 0.05, 1000);
+  };
+  EXPECT_NEAR(dimension(line), 1.0, 0.1);
+  EXPECT_NEAR(dimension(surface), 2.0, 0.2);
+  EXPECT_NEAR(dimension(volume), 3.0, 0.25);  // less at the cube's faces
+  const Points lonely = {Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 1, 1)};
+  EXPECT_EQ(dimension(lonely), 0.0) << "no neighbours: no dimension";
 }
 
 TEST(Preprocess, RemovesAWireAndReportsItsDirection) {

@@ -16,6 +16,9 @@ namespace modeling {
 struct ModelerConfig {
   // --- Preprocessing -------------------------------------------------------------------
   double voxel_size = 0.004;  ///< downsampling grid; 0 keeps every point
+  /// Points modeled at most: a cloud with more after downsampling is downsampled again on a
+  /// coarser grid until it fits, which bounds the modeler's memory and time (and says so)
+  int max_modeled_points = 2000000;
   // --- Algorithm 2: clusters, graph, trunk path ---------------------------------------
   int cluster_points = 3000;     ///< N_c = points / cluster_points (paper: ~3000 per cluster)
   double split_error = 0.004;    ///< e_t: mean |d - r| of a cluster's cylinder fit that splits it

@@ -11,6 +11,8 @@ struct PreprocessStats {
   std::size_t input = 0;
   std::size_t far_outliers = 0;  ///< stray points far outside the bulk of the cloud, dropped
   std::size_t after_voxel = 0;
+  std::size_t capped = 0;    ///< merged by a coarser grid to stay within max_modeled_points
+  double voxel_size = 0.0;   ///< the last grid used (m); coarser than voxel_size when capped > 0
   std::size_t floating = 0;  ///< isolated returns and mixed pixels (Eq. 1's targets)
   std::size_t ground = 0;
   std::size_t wires = 0;
@@ -42,7 +44,8 @@ Points voxelDownsample(const Points& pts, double voxel);
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors);
 
 /// @brief Downsample and, with config.ours_remove_clutter, drop floating pixels, the ground
-/// plane and trellis wires (long straight thin near-horizontal runs).
+/// plane and trellis wires (long straight thin near-horizontal runs); then, above
+/// config.max_modeled_points, downsample again on coarser grids.
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats);
 
 }  // namespace modeling

@@ -37,7 +37,10 @@ struct ModelResult {
   PreprocessStats preprocess;
   double noise_sigma = 0.0;  ///< range noise estimate used (m)
   double split_error = 0.0;  ///< e_t used (m)
-  int clusters = 0;          ///< after split and merge
+  /// neighbourGrowthDimension of the modeled points: about 2 for scanned surfaces, 3 for a
+  /// cloud filling a volume
+  double structure_dimension = 0.0;
+  int clusters = 0;  ///< after split and merge
   int trunk_clusters = 0;
   int primary_clusters = 0;
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
