@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
     ros::AsyncSpinner spinner(2);
     spinner.start();
     ros::waitForShutdown();
+    return node.exitStatus();
   } catch (const std::exception& e) {
     ROS_FATAL("tree_modeler: %s", e.what());
     return 1;

@@ -142,7 +142,8 @@ PoseErrors poseErrors(const RegistrationResult& result,
   return e;
 }
 
-std::string registrationToJson(const RegistrationResult& r) {
+std::string registrationToJson(const RegistrationResult& r,
+                               const std::optional<RegistrationInput>& input) {
   nlohmann::json views = nlohmann::json::array();
   for (const auto& v : r.views) {
     views.push_back({{"name", v.name},
@@ -154,17 +155,24 @@ std::string registrationToJson(const RegistrationResult& r) {
                      {"confidence", v.confidence},
                      {"reason", v.reason}});
   }
-  return nlohmann::json{{"format", "dormant_tree_registration/1"},
-                        {"frame", "the first registered view's frame"},
-                        {"stations", r.stations},
-                        {"stations_registered", r.stations_registered},
-                        {"seconds", r.seconds},
-                        {"seconds_prepare", r.seconds_prepare},
-                        {"seconds_placement", r.seconds_placement},
-                        {"seconds_refinement", r.seconds_refinement},
-                        {"views", views}}
-             .dump(1) +
-         "\n";
+  nlohmann::json out{{"format", "dormant_tree_registration/1"},
+                     {"frame", "the first registered view's frame"},
+                     {"stations", r.stations},
+                     {"stations_registered", r.stations_registered},
+                     {"seconds", r.seconds},
+                     {"seconds_prepare", r.seconds_prepare},
+                     {"seconds_placement", r.seconds_placement},
+                     {"seconds_refinement", r.seconds_refinement},
+                     {"views", views}};
+  if (input) {
+    out["input"] = {
+        {"ended_by", input->ended_by},
+        {"reported_views",
+         input->reported_views ? nlohmann::json(*input->reported_views) : nlohmann::json(nullptr)},
+        {"views_received", input->views_received},
+        {"complete", input->complete()}};
+  }
+  return out.dump(1) + "\n";
 }
 
 std::string registrationReport(const RegistrationResult& r,
@@ -208,14 +216,15 @@ Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationRes
 }
 
 void writeRegistration(const std::string& dir, const Cloud& registered,
-                       const RegistrationResult& result, const std::optional<PoseErrors>& errors) {
+                       const RegistrationResult& result, const std::optional<PoseErrors>& errors,
+                       const std::optional<RegistrationInput>& input) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec)
     throw Error(ErrorCode::IO_FAILURE, "cannot create " + dir + ": " + ec.message());
   io::writeCloud(dir + "/registered.pcd", registered);
   io::writeCloud(dir + "/registered.ply", registered);
-  io::writeTextFile(dir + "/registration.json", registrationToJson(result));
+  io::writeTextFile(dir + "/registration.json", registrationToJson(result, input));
   io::writeTextFile(dir + "/registration.md", registrationReport(result, errors));
 }
 

@@ -158,6 +158,8 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
   } catch (const tf2::TransformException&) {
   }
   bool start = false;
+  std::string ended_by;
+  std::optional<int> planned;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!hint || !last_hint_ || !samePlace(*hint, *last_hint_) || views_.empty())
@@ -173,12 +175,19 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
              dropped ? (", " + std::to_string(dropped) + " non-finite dropped").c_str() : "",
              views_.back().station, hint ? "" : " (no platform hint)");
     const int have = static_cast<int>(views_.size());
-    start = (expected_views_ > 0 && have >= expected_views_) ||
-            (awaited_views_ && have >= *awaited_views_);
+    if (awaited_views_ && have >= *awaited_views_) {
+      start = true;
+      ended_by = "plan_finished";
+      planned = awaited_views_;
+    } else if (expected_views_ > 0 && have >= expected_views_) {
+      start = true;
+      ended_by = "expected_views";
+      planned = expected_views_;
+    }
   }
   if (start) {
     std::string why;
-    if (!startRegistration(why))
+    if (!startRegistration(why, ended_by, planned))
       ROS_WARN("registration: %s", why.c_str());
   }
 }
@@ -204,20 +213,22 @@ void RegistrationNode::progressCallback(const std_msgs::StringConstPtr& msg) {
     }
   }
   std::string why;
-  if (!startRegistration(why))
+  if (!startRegistration(why, "plan_finished", named))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
 }
 
 void RegistrationNode::finishedWaitExpired() {
+  std::optional<int> planned;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!awaited_views_)
       return;  // they arrived in time
+    planned = awaited_views_;
     ROS_WARN("registration: the plan finished with %d views, only %zu arrived within %.1f s",
              *awaited_views_, views_.size(), finished_wait_);
   }
   std::string why;
-  if (!startRegistration(why))
+  if (!startRegistration(why, "plan_finished", planned))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
 }
 
@@ -240,14 +251,14 @@ void RegistrationNode::checkEndOfInput() {
       "finished: registering the %zu views that arrived",
       input_sub_.getTopic().c_str(), quiet, views);
   std::string why;
-  if (!startRegistration(why))
+  if (!startRegistration(why, "input_quiet"))
     ROS_WARN("registration: %s", why.c_str());
 }
 
 bool RegistrationNode::registerService(std_srvs::Trigger::Request&,
                                        std_srvs::Trigger::Response& res) {
   std::string why;
-  res.success = startRegistration(why);
+  res.success = startRegistration(why, "request");
   res.message = why;
   return true;
 }
@@ -262,7 +273,11 @@ bool RegistrationNode::resetService(std_srvs::Trigger::Request&, std_srvs::Trigg
   return true;
 }
 
-bool RegistrationNode::startRegistration(std::string& why) {
+bool RegistrationNode::startRegistration(std::string& why, const std::string& ended_by,
+                                         std::optional<int> planned) {
+  registration::RegistrationInput input;
+  input.ended_by = ended_by;
+  input.reported_views = planned;
   std::vector<registration::ViewInput> views;
   ros::Time stamp;
   {
@@ -285,11 +300,13 @@ bool RegistrationNode::startRegistration(std::string& why) {
   if (worker_.joinable())
     worker_.join();
   why = "registering " + std::to_string(views.size()) + " views";
-  worker_ = std::thread(&RegistrationNode::run, this, std::move(views), stamp);
+  input.views_received = static_cast<int>(views.size());
+  worker_ = std::thread(&RegistrationNode::run, this, std::move(views), stamp, std::move(input));
   return true;
 }
 
-void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time stamp) {
+void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time stamp,
+                           registration::RegistrationInput input) {
   std::string outcome;
   bool ok = false;
   try {
@@ -308,7 +325,7 @@ void RegistrationNode::run(std::vector<registration::ViewInput> views, ros::Time
     try {
       std::ostringstream dir;
       dir << output_dir_ << "/" << std::fixed << std::setprecision(0) << stamp.toSec();
-      registration::writeRegistration(dir.str(), registered, result);
+      registration::writeRegistration(dir.str(), registered, result, std::nullopt, input);
       s << "; " << registered.size() << " points written to " << dir.str();
     } catch (const Error& e) {
       s << "; NOT written: " << e.what();

@@ -77,6 +77,9 @@ TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     : modeler_(loadConfig(pnh)) {
   output_dir_ = pnh.param<std::string>("output_dir", "");
   output_frame_ = pnh.param<std::string>("output_frame", "");
+  exit_after_models_ = pnh.param<int>("exit_after_models", 0);
+  if (exit_after_models_ < 0)
+    throw Error(ErrorCode::INVALID_ARGUMENT, "~exit_after_models must be >= 0 (0: never)");
   if (!output_dir_.empty())
     std::filesystem::create_directories(output_dir_);
   diagnostics_.setHardwareID("none");
@@ -251,6 +254,17 @@ void TreeModelerNode::noteOutcome(bool ok, const std::string& message) {
   (ok ? models_ : failures_) += 1;
   last_ok_ = ok;
   last_outcome_ = message;
+  if (exit_after_models_ > 0 &&
+      models_ + failures_ >= static_cast<std::size_t>(exit_after_models_)) {
+    ROS_INFO("tree_modeler: %zu of %d clouds modeled (%zu failed): exiting (~exit_after_models)",
+             models_ + failures_, exit_after_models_, failures_);
+    ros::requestShutdown();
+  }
+}
+
+int TreeModelerNode::exitStatus() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_ok_ ? 0 : 1;
 }
 
 void TreeModelerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "dormant_tree_modeling/acquisition/range_image.h"
 #include "dormant_tree_modeling/acquisition/target_isolation.h"
@@ -282,6 +283,37 @@ TEST(ViewFolder, WarnsOfANearlyEmptyViewAndRefusesMistypedKeys) {
     EXPECT_NE(std::string(e.what()).find("'slide' must be a number"), std::string::npos)
         << e.what();
   }
+}
+
+}  // namespace
+}  // namespace registration
+}  // namespace dormant_tree_modeling
+
+namespace dormant_tree_modeling {
+namespace registration {
+namespace {
+
+TEST(RegistrationJson, RecordsWhatEndedTheInputAndWhetherEveryReportedViewCame) {
+  RegistrationResult result;
+  EXPECT_FALSE(nlohmann::json::parse(registrationToJson(result)).contains("input"))
+      << "a folder of views has no acquisition to record";
+  RegistrationInput input{"plan_finished", 40, 40};
+  EXPECT_TRUE(input.complete());
+  auto json = nlohmann::json::parse(registrationToJson(result, input)).at("input");
+  EXPECT_EQ(json.at("ended_by"), "plan_finished");
+  EXPECT_EQ(json.at("reported_views"), 40);
+  EXPECT_EQ(json.at("views_received"), 40);
+  EXPECT_TRUE(json.at("complete").get<bool>());
+  EXPECT_FALSE((RegistrationInput{"plan_finished", 40, 38}.complete())) << "two never came";
+  EXPECT_FALSE((RegistrationInput{"plan_finished", std::nullopt, 40}.complete()))
+      << "a finish that named no count proves nothing";
+  EXPECT_TRUE((RegistrationInput{"expected_views", 12, 12}.complete()));
+  const RegistrationInput quiet{"input_quiet", std::nullopt, 22};
+  EXPECT_FALSE(quiet.complete()) << "a bag that went quiet before the plan's end";
+  json = nlohmann::json::parse(registrationToJson(result, quiet)).at("input");
+  EXPECT_TRUE(json.at("reported_views").is_null());
+  EXPECT_FALSE(json.at("complete").get<bool>());
+  EXPECT_FALSE((RegistrationInput{"request", 40, 40}.complete())) << "a service call knows no end";
 }
 
 }  // namespace

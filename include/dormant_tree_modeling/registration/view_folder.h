@@ -59,8 +59,28 @@ struct PoseErrors {
 PoseErrors poseErrors(const RegistrationResult& result,
                       const std::vector<std::optional<Eigen::Isometry3d>>& true_poses);
 
-/// @brief Per-view poses and figures as JSON (format dormant_tree_registration/1).
-std::string registrationToJson(const RegistrationResult& result);
+/// @brief How a registration's views came in, when a node collected them from a live or
+/// replayed acquisition: what started the registration and whether every planned view was there.
+struct RegistrationInput {
+  /// "plan_finished" (the acquisition said so), "expected_views" (as many views arrived as the
+  /// node was told to expect), "input_quiet" (the recorded stage went silent before the plan's
+  /// end: a bag that ended early, was cut off or lacks the end), "request" (a service call)
+  std::string ended_by;
+  /// views the acquisition reported acquired (its "finished" message), or expected_views
+  std::optional<int> reported_views;
+  int views_received = 0;
+  /// @brief The plan reported its end (or the expected count came) and every view it named
+  /// arrived.
+  bool complete() const {
+    return (ended_by == "plan_finished" || ended_by == "expected_views") && reported_views &&
+           views_received >= *reported_views;
+  }
+};
+
+/// @brief Per-view poses and figures as JSON (format dormant_tree_registration/1), with the
+/// input's record under "input" when given.
+std::string registrationToJson(const RegistrationResult& result,
+                               const std::optional<RegistrationInput>& input = std::nullopt);
 
 /// @brief A Markdown report: one row per view, the stations left out and why.
 std::string registrationReport(const RegistrationResult& result,
@@ -75,7 +95,8 @@ Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationRes
 /// @throws Error IO_FAILURE naming the file
 void writeRegistration(const std::string& dir, const Cloud& registered,
                        const RegistrationResult& result,
-                       const std::optional<PoseErrors>& errors = std::nullopt);
+                       const std::optional<PoseErrors>& errors = std::nullopt,
+                       const std::optional<RegistrationInput>& input = std::nullopt);
 
 }  // namespace registration
 }  // namespace dormant_tree_modeling

@@ -16,6 +16,7 @@
 
 #include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
@@ -56,8 +57,12 @@ class RegistrationNode {
   bool resetService(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   /// Starts a registration of the collected views on the worker; false (and why) when busy
   /// or when nothing was collected.
-  bool startRegistration(std::string& why);
-  void run(std::vector<registration::ViewInput> views, ros::Time stamp);
+  /// @param ended_by what started it, @param planned the views the plan named (see
+  /// registration::RegistrationInput)
+  bool startRegistration(std::string& why, const std::string& ended_by,
+                         std::optional<int> planned = std::nullopt);
+  void run(std::vector<registration::ViewInput> views, ros::Time stamp,
+           registration::RegistrationInput input);
   void publish(const Cloud& registered, const std::vector<registration::ViewInput>& views,
                const registration::RegistrationResult& result, const ros::Time& stamp);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);

@@ -32,6 +32,8 @@ namespace ros_layer {
 /// Diagnostics: models made and failed, the last outcome, whether a cloud is being modeled.
 /// Modeling runs on a worker thread; a cloud arriving while one is being modeled waits in a
 /// single slot, replacing (with a warning) any cloud already waiting there.
+/// With `~exit_after_models` N > 0 the node shuts down once N clouds have been modeled or have
+/// failed (a replay that is to end, with `required` in its launch file).
 class TreeModelerNode {
  public:
   /// @throws Error when the configuration cannot be loaded
@@ -39,6 +41,10 @@ class TreeModelerNode {
   ~TreeModelerNode();
   TreeModelerNode(const TreeModelerNode&) = delete;
   TreeModelerNode& operator=(const TreeModelerNode&) = delete;
+
+  /// @brief The process's exit status: 0 when the last cloud was modeled (or none came), 1
+  /// when it failed.
+  int exitStatus();
 
  private:
   void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
@@ -73,6 +79,7 @@ class TreeModelerNode {
   bool stop_ = false;
   bool busy_ = false, last_ok_ = true;
   std::size_t models_ = 0, failures_ = 0;
+  int exit_after_models_ = 0;  // 0: never
   std::string last_outcome_ = "no cloud yet";
   std::set<std::string> warned_;  // the models' calibration warnings logged so far
   std::thread worker_;
