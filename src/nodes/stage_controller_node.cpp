@@ -12,6 +12,9 @@ int main(int argc, char** argv) {
     ros::AsyncSpinner spinner(2);
     spinner.start();
     ros::waitForShutdown();
+    // A home or move service call may be waiting on the controller: end it before the
+    // spinner joins its thread.
+    node.interrupt();
   } catch (const std::exception& e) {
     ROS_FATAL("stage_controller: %s", e.what());
     return 1;

@@ -102,9 +102,13 @@ StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& p
   feedback_thread_ = std::thread([this] { feedbackLoop(); });
 }
 
-StageControllerNode::~StageControllerNode() {
+void StageControllerNode::interrupt() {
   stop_ = true;
   stage_->interrupt();  // the threads' calls on a silent controller return at once
+}
+
+StageControllerNode::~StageControllerNode() {
+  interrupt();
   if (setup_thread_.joinable())
     setup_thread_.join();
   if (feedback_thread_.joinable())

@@ -36,6 +36,11 @@ class StageControllerNode {
   StageControllerNode(const StageControllerNode&) = delete;
   StageControllerNode& operator=(const StageControllerNode&) = delete;
 
+  /// @brief Ends every wait on the controller at once: the set-up and feedback threads', and a
+  /// move or home service call in progress (whose spinner thread is joined before the node is
+  /// destroyed). Called at shutdown, before the spinner stops.
+  void interrupt();
+
  private:
   bool moveAxis(dormant_tree_modeling::MoveAxis::Request& req,
                 dormant_tree_modeling::MoveAxis::Response& res);
