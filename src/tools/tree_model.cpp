@@ -70,7 +70,16 @@ int main(int argc, char** argv) {
     if (!calibration.empty())
       config.calibration = modeling::loadSensorCalibration(calibration);
     const modeling::TreeModeler modeler(config);
-    const auto cloud = io::readCloud(input);
+    io::CloudReadResult cloud;
+    try {
+      cloud = io::readCloud(input);
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::IO_FAILURE)
+        throw;
+      // An input the system will not let us read is unreadable input, not an output failure.
+      std::cerr << "tree_model: " << errorCodeName(e.code()) << ": " << e.what() << "\n";
+      return 3;
+    }
     if (cloud.dropped_non_finite > 0) {
       std::cerr << "tree_model: dropped " << cloud.dropped_non_finite << " NaN/Inf points\n";
     }

@@ -89,6 +89,12 @@ TEST(TreeModelTool, ExitCodesAreDistinctAndDocumented) {
       run("tree_model", dir.write("empty.xyz", "# nothing\n") + " -o " + dir.file("m.json"), &out),
       4)
       << out;
+  // A file the system will not read (any process's read of its own /proc/self/mem at 0 fails,
+  // even as root, where permissions would not): unreadable input, not an output failure (7).
+  std::filesystem::create_symlink("/proc/self/mem", dir.file("unreadable.xyz"));
+  EXPECT_EQ(run("tree_model", dir.file("unreadable.xyz") + " -o " + dir.file("m.json"), &out), 3)
+      << out;
+  EXPECT_NE(out.find("read error"), std::string::npos) << out;
   std::string plane;
   for (int i = 0; i < 60; ++i) {
     for (int k = 0; k < 60; ++k)
