@@ -14,7 +14,7 @@ endforeach()
 # The tool tests run the built tools.
 if(TARGET test_tools)
   add_dependencies(test_tools tree_model evaluate_model lms111_decode render_model synth_tree
-                   calibrate_diameters)
+                   calibrate_diameters lms111_emulator aerotech_emulator)
 endif()
 
 file(GLOB DTM_ROSTEST_NODES

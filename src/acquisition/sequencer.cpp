@@ -1,6 +1,7 @@
 #include "dormant_tree_modeling/acquisition/sequencer.h"
 
 #include <chrono>
+#include <iomanip>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -96,6 +97,19 @@ std::string outcomesMarkdown(const std::vector<ViewOutcome>& outcomes, int plann
         << o.seconds << " | " << o.message << " |\n";
   }
   return out.str();
+}
+
+std::string progressLine(const SequencerProgress& p) {
+  std::ostringstream m;
+  m << std::fixed << std::setprecision(1);
+  m << p.done << " of " << p.total << " views done, " << p.failed << " failed, "
+    << p.elapsed_s / 60.0 << " min elapsed, ";
+  if (p.done + p.failed > 0)
+    m << "about " << p.remaining_s / 60.0 << " min left: ";
+  else
+    m << "time left known after the first view: ";
+  m << p.message;
+  return m.str();
 }
 
 std::optional<int> viewsAcquired(const std::string& message) {

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
@@ -245,18 +244,9 @@ void AcquisitionNode::run() {
     return t.response.message;
   };
   a.progress = [this](const acquisition::SequencerProgress& p) {
-    std::ostringstream m;
-    m << std::fixed << std::setprecision(1);
-    m << p.done << " of " << p.total << " views done, " << p.failed << " failed, "
-      << p.elapsed_s / 60.0 << " min elapsed, ";
-    // No estimate before a view has been timed.
-    if (p.done + p.failed > 0)
-      m << "about " << p.remaining_s / 60.0 << " min left: ";
-    else
-      m << "time left known after the first view: ";
-    m << p.message;
-    publish(progress_pub_, m.str());
-    ROS_INFO("%s", m.str().c_str());
+    const std::string line = acquisition::progressLine(p);
+    publish(progress_pub_, line);
+    ROS_INFO("%s", line.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
     done_ = p.done;
     failed_ = p.failed;

@@ -69,6 +69,23 @@ TEST(Sequencer, ReadsTheViewCountOfAPlansEnd) {
   EXPECT_FALSE(viewsAcquired("finished: 99999999999999 of 40 planned views acquired"));
 }
 
+TEST(Sequencer, ProgressLineGivesNoEstimateBeforeTheFirstViewAndMinutesToATenth) {
+  SequencerProgress p;
+  p.total = 40;
+  p.elapsed_s = 7.2e-6;  // the first line of make demo once read "1.2e-07 min elapsed, about 0"
+  p.message = "view 1: moving the slide";
+  EXPECT_EQ(progressLine(p),
+            "0 of 40 views done, 0 failed, 0.0 min elapsed, time left known after the first "
+            "view: view 1: moving the slide");
+  p.done = 3;
+  p.failed = 1;
+  p.elapsed_s = 93.0;
+  p.remaining_s = 840.0;
+  p.message = "view 5: sweeping";
+  EXPECT_EQ(progressLine(p),
+            "3 of 40 views done, 1 failed, 1.6 min elapsed, about 14.0 min left: view 5: sweeping");
+}
+
 TEST(Sequencer, StopsWhenTheOperatorOrTheUserCancels) {
   const auto plan = shortPlan();
   SequencerActions a;

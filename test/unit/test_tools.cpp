@@ -231,6 +231,21 @@ TEST(Lms111DecodeTool, DecodesTheRealTelegramAndRejectsOthers) {
   EXPECT_NE(out.find("is a directory"), std::string::npos) << out;
 }
 
+TEST(EmulatorTools, RefuseAPortTcpCannotHaveAndATelegramThatIsADirectory) {
+  test::TempDir dir;
+  std::string out;
+  // 70000 once wrapped to 4464 silently; a directory as the telegram aborted the emulator.
+  EXPECT_EQ(run("lms111_emulator", "--cola-a-port 70000", &out), 3) << out;
+  EXPECT_NE(out.find("not 70000"), std::string::npos) << out;
+  EXPECT_EQ(run("aerotech_emulator", "--port 70000", &out), 3) << out;
+  EXPECT_NE(out.find("not 70000"), std::string::npos) << out;
+  EXPECT_EQ(
+      run("lms111_emulator", "--cola-a-port 0 --cola-b-port -1 --telegram " + dir.file(""), &out),
+      3)
+      << out;
+  EXPECT_NE(out.find("is a directory"), std::string::npos) << out;
+}
+
 // Counts the lines that contain `part`.
 std::size_t linesWith(const std::string& text, const std::string& part) {
   std::istringstream in(text);

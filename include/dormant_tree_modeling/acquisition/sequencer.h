@@ -20,6 +20,10 @@ struct SequencerProgress {
   std::string message;     ///< what happens now
 };
 
+/// @brief The operator's progress line: views done and failed, minutes elapsed to a tenth,
+/// and the minutes left once a view has been timed (before, no estimate), then the message.
+std::string progressLine(const SequencerProgress& progress);
+
 /// @brief What became of one view.
 struct ViewOutcome {
   int index = 0;
