@@ -8,10 +8,8 @@
 // Our world has the tuning trees (seeds 100..) the defaults were chosen on and held-out ones;
 // the variant worlds have held-out trees only, and our world also scores tree variants
 // (crooked leader, drooping or steep scaffolds, sparse or dense whorls): never tuned on.
-// Usage: accuracy_modeler [--trees N (tuning, per preset, default 4)] [--held-out N (default 4)]
-//                         [--variant-trees N (per preset, default 2)] [--out DIR]
-//                         [--noise-mm a,b,c] [--worlds ours,thin_beam,wide_beam,far_noise]
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -51,10 +49,26 @@ std::vector<std::string> split(const std::string& text) {
   return out;
 }
 
+constexpr const char* USAGE =
+    "Usage: accuracy_modeler [--trees N (tuning, per preset, default 4)] [--held-out N (default "
+    "4)] [--variant-trees N (per preset, default 2)] [--out DIR] [--noise-mm a,b,c] [--worlds "
+    "ours,thin_beam,wide_beam,far_noise]\n";
+
+/// The options; usage on stdout and exit 0 for --help, on stderr and exit 2 for anything else
+/// it does not know (an unknown option once ran the whole bench).
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
+  for (int i = 1; i < argc; i += 2) {
+    const std::string key = argv[i];
+    if (key == "--help" || key == "-h") {
+      std::cout << USAGE;
+      std::exit(0);
+    }
+    if (i + 1 >= argc) {
+      std::cerr << "accuracy_modeler: " << key << " needs a value\n" << USAGE;
+      std::exit(2);
+    }
+    const std::string value = argv[i + 1];
     if (key == "--trees")
       o.tuning = std::stoi(value);
     else if (key == "--held-out")
@@ -69,6 +83,9 @@ Options parse(int argc, char** argv) {
       o.noise_mm.clear();
       for (const auto& t : split(value))
         o.noise_mm.push_back(std::stod(t));
+    } else {
+      std::cerr << "accuracy_modeler: unknown option " << key << "\n" << USAGE;
+      std::exit(2);
     }
   }
   return o;

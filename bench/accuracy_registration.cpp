@@ -153,6 +153,13 @@ int main(int argc, char** argv) {
       out = argv[++i];
     else if (!std::strcmp(argv[i], "--no-baseline"))
       baseline = false;
+    else {
+      // An unknown option (--help included) once ran the whole bench.
+      std::fprintf(std::strcmp(argv[i], "--help") ? stderr : stdout,
+                   "Usage: accuracy_registration [--worlds ours,thin_beam,...] [--trees N] [--out "
+                   "DIR] [--no-baseline]\n");
+      return std::strcmp(argv[i], "--help") ? 2 : 0;
+    }
   }
   std::printf("%-24s %6s %7s %8s | %-33s | %-33s | %-22s | %-22s\n", "tree", "views", "time s",
               "peak MiB", "ours: reg, med/max mm, med/max deg", "PCL ICP chain: same",
