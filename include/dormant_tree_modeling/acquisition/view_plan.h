@@ -7,7 +7,7 @@
 namespace dormant_tree_modeling {
 namespace acquisition {
 
-/// @brief The acquisition plan of the paper's Algorithm 1 (hardware.md): per side of the row,
+/// @brief The acquisition plan of the paper's Algorithm 1 (docs/hardware.md): per side of the row,
 /// platform positions at two heights, two positions per height about 1 m apart, and at each
 /// position several views stepping the linear slide. Lengths in m, angles in degrees.
 struct ViewPlanConfig {
