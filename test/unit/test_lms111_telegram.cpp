@@ -46,7 +46,7 @@ TEST(ColaNumbers, HexSignedDecimalAndTwosComplement) {
 
 TEST(ScanTelegram, DecodesTheRealLms1xxTelegram) {
   const ScanTelegram s = parseScanTelegram(realTelegram());
-  // The decoded header of docs/hardware.md.
+  // The header as decoded by hand, field by field (layout: docs/protocols.md).
   EXPECT_EQ(s.command_type, "sSN");
   EXPECT_EQ(s.version, 1);
   EXPECT_EQ(s.device_number, 1);
