@@ -10,7 +10,7 @@
 namespace dormant_tree_modeling {
 namespace acquisition {
 
-/// @brief From one sweep's range image to the view cloud (algorithms.md 1.2-1.4).
+/// @brief From one sweep's range image to the view cloud (docs/algorithms.md, section 1).
 struct ViewProcessingConfig {
   double floating_threshold = 0.05;  ///< rho_T of Eq. 1, m
   int smoothing_iterations = 0;      ///< range smoothing passes (0: off; the modeler's

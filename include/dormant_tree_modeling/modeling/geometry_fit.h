@@ -100,8 +100,7 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
 
 /// @brief Radius corrected for range noise: sqrt(mean d^2 - sigma^2) over the points closer
 /// to the axis than radius + `band`, never below `min_radius`. A return's squared distance to
-/// the axis is on average r^2 + sigma^2, so the plain fit estimates about sqrt(r^2 + sigma^2)
-/// (algorithms.md, PCL traps).
+/// the axis is on average r^2 + sigma^2, so the plain fit estimates about sqrt(r^2 + sigma^2).
 
 double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,
                             double min_radius);
