@@ -1,4 +1,4 @@
-// tree_model: the tree modeler on a cloud file. Exit codes are documented in the README.
+// tree_model: the tree modeler on a cloud file. Exit codes are documented in the README and --help.
 #include <boost/program_options.hpp>
 #include <iostream>
 #include <map>

@@ -97,7 +97,7 @@ TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
   RecordProperty("f1", std::to_string(score.f1));
   RecordProperty("branch_mae_mm", std::to_string(1000 * score.branch_mae));
   RecordProperty("trunk_mae_mm", std::to_string(1000 * score.trunk_mae));
-  // Bounds a little under what this configuration measures (docs: README, modeler section):
+  // Bounds a little under what this configuration measures (docs/benchmarks.md):
   // they catch regressions, they are not the product targets, which make bench reports.
   EXPECT_GE(score.f1, 0.75) << evaluation::formatTable({score});
   // Measured with this reduced 4-view plan: F1 0.80, branch MAE 2.8 mm, trunk MAE 2.1 mm.
