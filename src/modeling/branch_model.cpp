@@ -9,6 +9,7 @@
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_rays.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -251,7 +252,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
   const double scatter = config.ours_correct_noise_bias ? trunk.scatter : 0.0;
   double threshold = config.cylinder_threshold;
   if (config.ours_derive_parameters)
-    threshold = std::max(threshold, 2.5 * sigma);
+    threshold = std::max(threshold, noiseBand(sigma));
   const double base_z = trunk.baseZ();
   const double s_lo = trunk.cylinder_ranges.front().first - 0.05;
   const double s_hi = trunk.cylinder_ranges.back().second + 0.05;
@@ -362,7 +363,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
           const auto ray = strongestRay(cluster_pts, trunk.cylinders[segment],
                                         config.branch_min_elevation, config.branch_max_steep_angle);
           if (ray) {
-            const double tube = std::max(2.5 * sigma, RAY_MIN_BAND) + RAY_TUBE_RADIUS;
+            const double tube = std::max(noiseBand(sigma), RAY_MIN_BAND) + RAY_TUBE_RADIUS;
             std::vector<int> on, rest;
             for (const int k : cluster)
               (rayDistance(*ray, cand_pts[k]) < tube ? on : rest).push_back(k);
@@ -396,7 +397,7 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     // cluster. Returns the points taken out.
     auto searchRest = [&](const Cylinder& found) {
       std::vector<int> taken;
-      const double reach = found.radius + 2.5 * std::max(sigma, scatter) + 0.005;
+      const double reach = found.radius + noiseBand(std::max(sigma, scatter)) + 0.005;
       std::vector<int> rest;
       for (const int k : cluster) {
         if (axisDistance(found, cand_pts[k]) > reach) {

@@ -7,6 +7,7 @@
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -259,7 +260,7 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   const int n = static_cast<int>(pts.size());
   if (n < 6)
     return std::nullopt;
-  const double band = max_radius + std::max(2.5 * sigma, 0.004);
+  const double band = max_radius + std::max(noiseBand(sigma), 0.004);
   auto lineInliers = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
                          std::vector<int>& out) {
     out.clear();
@@ -312,7 +313,7 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   double radius = max_radius;
   for (int round = 0; round < 5; ++round) {
     // The moment must see the whole scatter it then subtracts.
-    const double reach = radius + 2.5 * std::max(sigma, scatter) + 0.002;
+    const double reach = radius + noiseBand(std::max(sigma, scatter)) + 0.002;
 
     used.clear();
     std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
@@ -381,7 +382,7 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
     // it may exceed the radius bound by the scatter it carries.
     const double upper =
-        scatter > 0.0 ? max_radius : max_radius + 2.5 * std::max(sigma, 0.004) + 0.002;
+        scatter > 0.0 ? max_radius : max_radius + noiseBand(std::max(sigma, 0.004)) + 0.002;
     radius = std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_RADIUS, upper);
   }
   cyl.radius = radius;

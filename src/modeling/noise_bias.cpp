@@ -11,6 +11,7 @@
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 
 namespace dormant_tree_modeling {
@@ -82,7 +83,7 @@ Points2 noisySlice(double r, double sigma, Rng& rng) {
 CircleRansacOptions sliceOptions(const ModelerConfig& config, double r, double sigma,
                                  std::uint64_t seed) {
   CircleRansacOptions o;
-  o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, 2.5 * sigma)
+  o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, noiseBand(sigma))
                                               : config.circle_threshold;
   o.iterations = config.ransac_iterations;
   o.min_radius = std::max(MIN_TRUNK_RADIUS_M, SLICE_MIN_FACTOR * r);

@@ -16,6 +16,7 @@
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/structure.h"
@@ -145,7 +146,7 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     if (clusters[c].fit)
       guesses.push_back(noiseGuess(pts, clusters[c]));
   }
-  const double threshold = std::max(0.5 * config.circle_threshold, 2.5 * median(guesses));
+  const double threshold = std::max(0.5 * config.circle_threshold, noiseBand(median(guesses)));
   // Candidates are tracked independently, on all cores; the best is chosen in candidate order.
   std::vector<std::optional<TrackedTrunk>> tracks(candidates.size());
   std::vector<double> scores(candidates.size(), -1.0);
@@ -543,7 +544,7 @@ ModelResult TreeModeler::model(const Points& input) const {
         continue;
       ++total;
       if (std::abs(axisDistance(c, pts[k]) - c.radius) <
-          std::max(config_.cylinder_threshold, 2.5 * trunk.noise_sigma)) {
+          std::max(config_.cylinder_threshold, noiseBand(trunk.noise_sigma))) {
         ++inliers;
         result.classes[k] = PointClass::TRUNK;
       }

@@ -10,6 +10,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/taper_profile.h"
 
@@ -49,7 +50,7 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const Circle
   auto circle = ransacCircle(plane, o, &inliers);
   if (!circle)
     return std::nullopt;
-  if (o.threshold / 2.5 > 0.2 * circle->radius) {
+  if (sigmaOfBand(o.threshold) > 0.2 * circle->radius) {
     // Noise comparable to the radius: the circle band covers the whole disc and its centre
     // drifts towards branch bases; the disc's trimmed mean is the better centre.
     Eigen::Vector2d centre = circle->center;
@@ -73,7 +74,7 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const Circle
   if (surface) {
     // The surface under the branch bases: the mode of the distances from the centre.
     if (const auto mode =
-            surfaceCircle(plane, *circle, o.threshold / 2.5, min_radius, max_radius)) {
+            surfaceCircle(plane, *circle, sigmaOfBand(o.threshold), min_radius, max_radius)) {
       out.circle = *mode;
       out.surface = true;
     }
@@ -406,7 +407,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     o.seed = config.seed * 31337 + stream++;
     std::vector<int> inliers;
     std::optional<Circle> circle;
-    const double sigma = threshold / 2.5;
+    const double sigma = sigmaOfBand(threshold);
     if (plane.size() < MIN_SLICE_POINTS) {
       // nothing to fit
     } else if (first || sigma < 0.2 * r) {
@@ -417,7 +418,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
       // Noise comparable to the radius: a circle band would cover the whole disc. The disc's
       // trimmed mean is its centre (views all around), its second moment r^2 + sigma^2.
       Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-      const double window = r + 2.5 * sigma;
+      const double window = r + noiseBand(sigma);
       for (int round = 0; round < 4; ++round) {
         Eigen::Vector2d sum = Eigen::Vector2d::Zero();
         inliers.clear();
@@ -581,8 +582,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   trunk.scatter = scatter;
   double circle_threshold = config.circle_threshold, cylinder_threshold = config.cylinder_threshold;
   if (config.ours_derive_parameters) {
-    circle_threshold = std::max(circle_threshold, 2.5 * sigma);
-    cylinder_threshold = std::max(cylinder_threshold, 2.5 * sigma);
+    circle_threshold = std::max(circle_threshold, noiseBand(sigma));
+    cylinder_threshold = std::max(cylinder_threshold, noiseBand(sigma));
   }
   if (config.ours_constrain_ransac || config.ours_derive_parameters ||
       config.ours_correct_noise_bias) {
