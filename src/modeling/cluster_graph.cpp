@@ -322,7 +322,8 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
   std::size_t best_size = best_path.trunk.size() + best_path.primary.size();
   for (int c = 0; c < n; ++c) {
     const auto& fit = clusters[c].fit;
-    if (c == lowest || clusters[c].centroid.z() > zmin + 0.3 || adjacency[c].empty() ||
+    if (c == lowest || clusters[c].centroid.z() > zmin + TRUNK_BASE_BAND_M ||
+        adjacency[c].empty() ||
         static_cast<int>(clusters[c].members.size()) < 2 * config.min_cluster_points || !fit ||
         std::abs(fit->axis.z()) < std::cos(config.trunk_max_tilt * DEG)) {
       continue;

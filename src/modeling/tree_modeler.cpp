@@ -123,8 +123,8 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   std::vector<int> candidates{path.trunk.front()};
   for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
     const auto& fit = clusters[c].fit;
-    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + 0.3 && fit &&
-        fit->radius < 0.3 &&
+    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + TRUNK_BASE_BAND_M && fit &&
+        fit->radius < MAX_TRUNK_FIT_RADIUS_M &&
         static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
         std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0)) {
       candidates.push_back(c);
@@ -471,7 +471,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   std::sort(region.begin(), region.end());
   std::vector<double> radii;
   for (const int c : path.trunk) {
-    if (clusters[c].fit && clusters[c].fit->radius < 0.3)
+    if (clusters[c].fit && clusters[c].fit->radius < MAX_TRUNK_FIT_RADIUS_M)
       radii.push_back(clusters[c].fit->radius);
   }
   std::sort(radii.begin(), radii.end());

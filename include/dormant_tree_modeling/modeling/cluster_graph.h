@@ -11,6 +11,14 @@ namespace dormant_tree_modeling {
 namespace modeling {
 
 /// @brief A cluster of points (indices into the modeled cloud) and its cylinder fit.
+/// @brief Clusters whose centroid lies at most this far (m) above the lowest cluster's are where
+/// a trunk may start: Algorithm 2's start candidates and the trunk tracking's bases.
+constexpr double TRUNK_BASE_BAND_M = 0.3;
+
+/// @brief The widest cluster fit (m of radius) taken for a piece of trunk: a wider one is a
+/// patch of ground, a wall or an arc of clutter.
+constexpr double MAX_TRUNK_FIT_RADIUS_M = 0.3;
+
 struct Cluster {
   std::vector<int> members;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();

@@ -87,7 +87,8 @@ struct SliceCircle {
 };
 
 /// @brief The trunk step's estimator of one cross-section: a RANSAC circle; its centre from the
-/// disc's trimmed mean where the band (options.threshold) exceeds a fifth of the radius; with
+/// disc's trimmed mean where the noise the band stands for (sigmaOfBand(options.threshold))
+/// exceeds a fifth of the radius; with
 /// `surface`, the mode circle of the surface (surfaceCircle, bandwidth sigmaOfBand(threshold))
 /// within [min_radius, max_radius]. The noise model (noise_bias.h) runs this very estimator.
 /// @return nothing when RANSAC finds no circle
