@@ -38,6 +38,10 @@ constexpr double MAX_STRUCTURE_DIMENSION = 2.5;
 // times the LMS111's specified 1-sigma statistical error, and more than a young branch's
 // radius, so no diameter would mean anything.
 constexpr double MAX_NOISE_SIGMA_M = 0.05;
+// A trunk track scores the points between these distances (m) beyond its surface: branches.
+// A post has none; a neighbour's branch is no vertical cylinder.
+constexpr double BRANCH_SHELL_INNER_M = 0.05;
+constexpr double BRANCH_SHELL_OUTER_M = 0.35;
 constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
 constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
@@ -186,8 +190,8 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     double shell = 0.0;
     for (std::size_t k2 = 0; k2 < tracked.centers.size(); k2 += 2) {
       const double r = tracked.radii[k2];
-      shell += index.countWithin(tracked.centers[k2], r + 0.35, 1 << 20) -
-               index.countWithin(tracked.centers[k2], r + 0.05, 1 << 20);
+      shell += index.countWithin(tracked.centers[k2], r + BRANCH_SHELL_OUTER_M, 1 << 20) -
+               index.countWithin(tracked.centers[k2], r + BRANCH_SHELL_INNER_M, 1 << 20);
     }
     const double off_centre = (start.head<2>() - middle).norm() / CENTRE_PRIOR_SCALE;
     // A trunk stands on the ground: a track whose lowest slice floats above the cloud's
@@ -484,7 +488,7 @@ ModelResult TreeModeler::model(const Points& input) const {
       // The trunk region becomes every point near the tracked axis, not only the clusters
       // Algorithm 2 linked.
       const Centerline line(axis);
-      const double reach = std::max(3.0 * radius, radius + 0.05);
+      const double reach = trunkReach(radius);
       // A near point's closest axis point lies within 5 cm of the vertices' box (the ends
       // extend by that much), so a point farther than reach + 5 cm from the box is not near.
       Eigen::Vector3d lo = axis.front(), hi = axis.front();

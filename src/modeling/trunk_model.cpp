@@ -390,7 +390,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     // Until the first circle is found the start's radius is only a guess (a cluster's fit
     // to an arc of a thick trunk can be half its size): search wide, any trunk radius.
     const bool first = out.centers.empty() && !trust_radius;
-    const double lateral = first ? std::max(FIRST_WINDOW, 3.0 * r) : std::max(3.0 * r, r + 0.05);
+    const double lateral = first ? std::max(FIRST_WINDOW, TRUNK_REACH_RADII * r) : trunkReach(r);
     const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
     Points2 plane;
     for (const int i : index.within(predicted, std::hypot(0.5 * h, lateral))) {
@@ -556,7 +556,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   if (initial_radius > 0.0) {
     bounds.min_radius = std::max(MIN_TRUNK_RADIUS, 0.3 * initial_radius);
     bounds.max_radius = std::min(MAX_TRUNK_RADIUS, 2.5 * initial_radius);
-    bounds.max_distance = std::max(3.0 * initial_radius, initial_radius + 0.05);
+    bounds.max_distance = trunkReach(initial_radius);
   }
   // Pass 1: slices on the initial axis, to refine the centreline and estimate the noise.
   auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds,

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -124,6 +125,18 @@ struct TrackedTrunk {
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
                         const ModelerConfig& config, int max_misses = 4, bool trust_radius = false);
+
+/// @brief The trunk's neighbourhood reaches this many radii from its axis ...
+constexpr double TRUNK_REACH_RADII = 3.0;
+/// @brief ... and at least this far (m) beyond its surface.
+constexpr double TRUNK_REACH_MIN_GAP_M = 0.05;
+
+/// @brief The trunk's neighbourhood (m from its axis) at radius `radius` (m). Slices, tracks
+/// and the trunk region look this far: branch bases and noise lie within it, the next tree's
+/// wood does not.
+inline double trunkReach(double radius) {
+  return std::max(TRUNK_REACH_RADII * radius, radius + TRUNK_REACH_MIN_GAP_M);
+}
 
 /// @brief Algorithm 3 steps 1-4 on the trunk region.
 
