@@ -143,19 +143,23 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
   // The laser's place in the view's frame (for the side a surface was seen from), and the
   // platform's hinted place in the orchard.
   v.sensor = Eigen::Vector3d::Zero();  // the frame's origin: close enough to tell the side
-  if (tf_buffer_._frameExists(laser_frame_)) {
+  if (frameKnown(tf_buffer_, laser_frame_)) {
     try {
       v.sensor = tf2::transformToEigen(lookupWithin(tf_buffer_, msg->header.frame_id, laser_frame_,
                                                     msg->header.stamp, hint_timeout_))
                      .translation();
-    } catch (const tf2::TransformException&) {
+    } catch (const tf2::TransformException& e) {
+      ROS_DEBUG_THROTTLE(10.0, "registration: laser position unknown, frame origin used: %s",
+                         e.what());
     }
   }
   std::optional<Eigen::Isometry3d> hint;
   try {
     hint = tf2::transformToEigen(lookupWithin(tf_buffer_, orchard_frame_, msg->header.frame_id,
                                               msg->header.stamp, hint_timeout_));
-  } catch (const tf2::TransformException&) {
+  } catch (const tf2::TransformException& e) {
+    // No hint: the view starts a station of its own (said in the log line below).
+    ROS_DEBUG_THROTTLE(10.0, "registration: no platform hint: %s", e.what());
   }
   bool start = false;
   std::string ended_by;

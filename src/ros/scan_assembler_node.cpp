@@ -251,7 +251,7 @@ std::string ScanAssemblerNode::acquire() {
 Eigen::Vector3d ScanAssemblerNode::treeHint(const ros::Time& stamp) {
   // Where the plan (the acquisition's orchard -> platform) puts the tree: its frame's origin,
   // the base of the trunk on the ground.
-  if (!tree_frame_.empty() && tf_buffer_._frameExists(tree_frame_)) {
+  if (!tree_frame_.empty() && frameKnown(tf_buffer_, tree_frame_)) {
     try {
       const auto t =
           lookupWithin(tf_buffer_, platform_frame_, tree_frame_, stamp, TF_WAIT_S).transform;

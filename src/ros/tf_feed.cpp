@@ -36,6 +36,10 @@ void TfFeed::add(const tf2_msgs::TFMessage& msg, const std::string& authority, b
   }
 }
 
+bool frameKnown(const tf2_ros::Buffer& buffer, const std::string& frame) {
+  return buffer._frameExists(frame);
+}
+
 geometry_msgs::TransformStamped lookupWithin(const tf2_ros::Buffer& buffer,
                                              const std::string& target, const std::string& source,
                                              const ros::Time& stamp, double wall_timeout_s) {

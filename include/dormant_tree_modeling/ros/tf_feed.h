@@ -40,6 +40,11 @@ class TfFeed {
   std::unique_ptr<ros::AsyncSpinner> spinner_;
 };
 
+/// @brief Whether the buffer has heard of `frame` at all, so that a lookup that can never
+/// succeed is not waited for. The one place the nodes use tf2's underscored `_frameExists`:
+/// tf2 has no public existence query, and `canTransform(f, f)` answers true for any name.
+bool frameKnown(const tf2_ros::Buffer& buffer, const std::string& frame);
+
 /// @brief tf lookup that waits for the transform in wall time.
 ///
 /// tf2's own timeout runs on ros::Time: in a replay, sim time stands still whenever the bag
