@@ -142,6 +142,20 @@ PoseErrors poseErrors(const RegistrationResult& result,
   return e;
 }
 
+const char* endName(RegistrationInput::End end) {
+  switch (end) {
+    case RegistrationInput::End::PLAN_FINISHED:
+      return "plan_finished";
+    case RegistrationInput::End::EXPECTED_VIEWS:
+      return "expected_views";
+    case RegistrationInput::End::INPUT_QUIET:
+      return "input_quiet";
+    case RegistrationInput::End::REQUEST:
+      return "request";
+  }
+  return "request";
+}
+
 std::string registrationToJson(const RegistrationResult& r,
                                const std::optional<RegistrationInput>& input) {
   nlohmann::json views = nlohmann::json::array();
@@ -166,7 +180,7 @@ std::string registrationToJson(const RegistrationResult& r,
                      {"views", views}};
   if (input) {
     out["input"] = {
-        {"ended_by", input->ended_by},
+        {"ended_by", endName(input->ended_by)},
         {"reported_views",
          input->reported_views ? nlohmann::json(*input->reported_views) : nlohmann::json(nullptr)},
         {"views_received", input->views_received},

@@ -162,7 +162,8 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
     ROS_DEBUG_THROTTLE(10.0, "registration: no platform hint: %s", e.what());
   }
   bool start = false;
-  std::string ended_by;
+  using End = registration::RegistrationInput::End;
+  End ended_by = End::REQUEST;
   std::optional<int> planned;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -181,11 +182,11 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
     const int have = static_cast<int>(views_.size());
     if (awaited_views_ && have >= *awaited_views_) {
       start = true;
-      ended_by = "plan_finished";
+      ended_by = End::PLAN_FINISHED;
       planned = awaited_views_;
     } else if (expected_views_ > 0 && have >= expected_views_) {
       start = true;
-      ended_by = "expected_views";
+      ended_by = End::EXPECTED_VIEWS;
       planned = expected_views_;
     }
   }
@@ -217,7 +218,7 @@ void RegistrationNode::progressCallback(const std_msgs::StringConstPtr& msg) {
     }
   }
   std::string why;
-  if (!startRegistration(why, "plan_finished", named))
+  if (!startRegistration(why, registration::RegistrationInput::End::PLAN_FINISHED, named))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
 }
 
@@ -232,7 +233,7 @@ void RegistrationNode::finishedWaitExpired() {
              *awaited_views_, views_.size(), finished_wait_);
   }
   std::string why;
-  if (!startRegistration(why, "plan_finished", planned))
+  if (!startRegistration(why, registration::RegistrationInput::End::PLAN_FINISHED, planned))
     ROS_WARN("registration: the plan finished, but %s", why.c_str());
 }
 
@@ -255,14 +256,14 @@ void RegistrationNode::checkEndOfInput() {
       "finished: registering the %zu views that arrived",
       input_sub_.getTopic().c_str(), quiet, views);
   std::string why;
-  if (!startRegistration(why, "input_quiet"))
+  if (!startRegistration(why, registration::RegistrationInput::End::INPUT_QUIET))
     ROS_WARN("registration: %s", why.c_str());
 }
 
 bool RegistrationNode::registerService(std_srvs::Trigger::Request&,
                                        std_srvs::Trigger::Response& res) {
   std::string why;
-  res.success = startRegistration(why, "request");
+  res.success = startRegistration(why, registration::RegistrationInput::End::REQUEST);
   res.message = why;
   return true;
 }
@@ -277,7 +278,8 @@ bool RegistrationNode::resetService(std_srvs::Trigger::Request&, std_srvs::Trigg
   return true;
 }
 
-bool RegistrationNode::startRegistration(std::string& why, const std::string& ended_by,
+bool RegistrationNode::startRegistration(std::string& why,
+                                         registration::RegistrationInput::End ended_by,
                                          std::optional<int> planned) {
   registration::RegistrationInput input;
   input.ended_by = ended_by;

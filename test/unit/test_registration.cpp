@@ -294,26 +294,31 @@ namespace registration {
 namespace {
 
 TEST(RegistrationJson, RecordsWhatEndedTheInputAndWhetherEveryReportedViewCame) {
+  using End = RegistrationInput::End;
   RegistrationResult result;
   EXPECT_FALSE(nlohmann::json::parse(registrationToJson(result)).contains("input"))
       << "a folder of views has no acquisition to record";
-  RegistrationInput input{"plan_finished", 40, 40};
+  RegistrationInput input{End::PLAN_FINISHED, 40, 40};
   EXPECT_TRUE(input.complete());
   auto json = nlohmann::json::parse(registrationToJson(result, input)).at("input");
   EXPECT_EQ(json.at("ended_by"), "plan_finished");
   EXPECT_EQ(json.at("reported_views"), 40);
   EXPECT_EQ(json.at("views_received"), 40);
   EXPECT_TRUE(json.at("complete").get<bool>());
-  EXPECT_FALSE((RegistrationInput{"plan_finished", 40, 38}.complete())) << "two never came";
-  EXPECT_FALSE((RegistrationInput{"plan_finished", std::nullopt, 40}.complete()))
+  EXPECT_FALSE((RegistrationInput{End::PLAN_FINISHED, 40, 38}.complete())) << "two never came";
+  EXPECT_FALSE((RegistrationInput{End::PLAN_FINISHED, std::nullopt, 40}.complete()))
       << "a finish that named no count proves nothing";
-  EXPECT_TRUE((RegistrationInput{"expected_views", 12, 12}.complete()));
-  const RegistrationInput quiet{"input_quiet", std::nullopt, 22};
+  EXPECT_TRUE((RegistrationInput{End::EXPECTED_VIEWS, 12, 12}.complete()));
+  const RegistrationInput quiet{End::INPUT_QUIET, std::nullopt, 22};
   EXPECT_FALSE(quiet.complete()) << "a bag that went quiet before the plan's end";
   json = nlohmann::json::parse(registrationToJson(result, quiet)).at("input");
+  EXPECT_EQ(json.at("ended_by"), "input_quiet");
   EXPECT_TRUE(json.at("reported_views").is_null());
   EXPECT_FALSE(json.at("complete").get<bool>());
-  EXPECT_FALSE((RegistrationInput{"request", 40, 40}.complete())) << "a service call knows no end";
+  EXPECT_STREQ(endName(End::EXPECTED_VIEWS), "expected_views");
+  EXPECT_STREQ(endName(End::REQUEST), "request");
+  EXPECT_FALSE((RegistrationInput{End::REQUEST, 40, 40}.complete()))
+      << "a service call knows no end";
 }
 
 }  // namespace

@@ -62,20 +62,29 @@ PoseErrors poseErrors(const RegistrationResult& result,
 /// @brief How a registration's views came in, when a node collected them from a live or
 /// replayed acquisition: what started the registration and whether every planned view was there.
 struct RegistrationInput {
-  /// "plan_finished" (the acquisition said so), "expected_views" (as many views arrived as the
-  /// node was told to expect), "input_quiet" (the recorded stage went silent before the plan's
-  /// end: a bag that ended early, was cut off or lacks the end), "request" (a service call)
-  std::string ended_by;
+  /// What started the registration.
+  enum class End {
+    PLAN_FINISHED,   ///< the acquisition reported the plan's end
+    EXPECTED_VIEWS,  ///< as many views arrived as the node was told to expect
+    INPUT_QUIET,     ///< the recorded stage went silent before the plan's end (a bag that
+                     ///< ended early, was cut off or lacks the end)
+    REQUEST,         ///< a service call
+  };
+  End ended_by = End::REQUEST;
   /// views the acquisition reported acquired (its "finished" message), or expected_views
   std::optional<int> reported_views;
   int views_received = 0;
   /// @brief The plan reported its end (or the expected count came) and every view it named
   /// arrived.
   bool complete() const {
-    return (ended_by == "plan_finished" || ended_by == "expected_views") && reported_views &&
+    return (ended_by == End::PLAN_FINISHED || ended_by == End::EXPECTED_VIEWS) && reported_views &&
            views_received >= *reported_views;
   }
 };
+
+/// @brief The name registration.json gives an end: "plan_finished", "expected_views",
+/// "input_quiet" or "request".
+const char* endName(RegistrationInput::End end);
 
 /// @brief Per-view poses and figures as JSON (format dormant_tree_registration/1), with the
 /// input's record under "input" when given.

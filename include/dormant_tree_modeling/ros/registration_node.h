@@ -59,7 +59,7 @@ class RegistrationNode {
   /// or when nothing was collected.
   /// @param ended_by what started it, @param planned the views the plan named (see
   /// registration::RegistrationInput)
-  bool startRegistration(std::string& why, const std::string& ended_by,
+  bool startRegistration(std::string& why, registration::RegistrationInput::End ended_by,
                          std::optional<int> planned = std::nullopt);
   void run(std::vector<registration::ViewInput> views, ros::Time stamp,
            registration::RegistrationInput input);
