@@ -110,6 +110,25 @@ std::vector<double> trackOffsets(const TrackedTrunk& a, const TrackedTrunk& b,
   return out;
 }
 
+/// What preprocessing did that the user should hear of, one sentence each.
+std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t modeled,
+                                           const ModelerConfig& config) {
+  std::vector<std::string> out;
+  if (s.far_outliers > 0) {
+    out.push_back("dropped " + std::to_string(s.far_outliers) +
+                  " stray points far outside the cloud's bulk");
+  }
+  if (s.capped > 0) {
+    char text[200];
+    std::snprintf(text, sizeof(text),
+                  "%zu points modeled on a %.1f mm grid, coarser than voxel_size, to stay within "
+                  "max_modeled_points (%d)",
+                  modeled, 1000.0 * s.voxel_size, config.max_modeled_points);
+    out.emplace_back(text);
+  }
+  return out;
+}
+
 /// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder
 /// piece near the bottom, Algorithm 2's start among them), group the tracks that stand on one
 /// base, and keep the trunk whose tracks have the most points around them between 5 and 35 cm
@@ -416,6 +435,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   }
   result.points = preprocess(finite < input.size() ? clean : input, config_, &result.preprocess);
   Points().swap(clean);
+  result.notices = preprocessNotices(result.preprocess, result.points.size(), config_);
   const Points& pts = result.points;
   watch.lap("preprocess");
   if (pts.size() < MIN_POINTS) {
@@ -426,9 +446,10 @@ ModelResult TreeModeler::model(const Points& input) const {
   // One index of the modeled cloud for the spacing, the graph, the trunk tracking and the
   // branch step.
   const PointIndex index(pts);
+  watch.lap("index");
   result.structure_dimension =
       neighbourGrowthDimension(pts, index, STRUCTURE_RADIUS_M, STRUCTURE_SAMPLES);
-  watch.lap("index");
+  watch.lap("structure");
   if (result.structure_dimension > MAX_STRUCTURE_DIMENSION) {
     char text[256];
     std::snprintf(text, sizeof(text),

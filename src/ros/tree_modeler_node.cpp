@@ -177,15 +177,8 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
     if (dropped > 0)
       ROS_WARN("tree_modeler: dropped %zu NaN/Inf points", dropped);
     const modeling::ModelResult result = modeler_.model(*cloud);
-    const modeling::PreprocessStats& pre = result.preprocess;
-    if (pre.far_outliers > 0)
-      ROS_WARN("tree_modeler: dropped %zu stray points far outside the cloud's bulk",
-               pre.far_outliers);
-    if (pre.capped > 0)
-      ROS_WARN(
-          "tree_modeler: %zu points modeled on a %.1f mm grid, coarser than voxel_size, to "
-          "stay within max_modeled_points",
-          result.points.size(), 1000.0 * pre.voxel_size);
+    for (const auto& notice : result.notices)
+      ROS_WARN("tree_modeler: %s", notice.c_str());
     warnOnce(result.model.correction.warnings);
     const std::string summary = publish(result, msg.header);
     if (!output_dir_.empty())

@@ -84,16 +84,8 @@ int main(int argc, char** argv) {
       std::cerr << "tree_model: dropped " << cloud.dropped_non_finite << " NaN/Inf points\n";
     }
     const auto result = modeler.model(*cloud.cloud);
-    if (result.preprocess.capped > 0) {
-      std::cerr << "tree_model: warning: " << result.points.size() << " points modeled on a "
-                << 1000.0 * result.preprocess.voxel_size
-                << " mm grid, coarser than voxel_size, to stay within max_modeled_points ("
-                << config.max_modeled_points << ")\n";
-    }
-    if (result.preprocess.far_outliers > 0) {
-      std::cerr << "tree_model: dropped " << result.preprocess.far_outliers
-                << " stray points far outside the cloud's bulk\n";
-    }
+    for (const auto& w : result.notices)
+      std::cerr << "tree_model: warning: " << w << "\n";
     for (const auto& w : result.model.correction.warnings)
       std::cerr << "tree_model: warning: " << w << "\n";
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));

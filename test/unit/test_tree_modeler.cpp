@@ -164,6 +164,25 @@ TEST(TreeModeler, ChoosesTheCentredTrunkWhenSomeOfItsTracksStopLow) {
   EXPECT_LE(score.trunk_mae, 0.008) << evaluation::formatTable({score});
 }
 
+TEST(TreeModeler, SaysWhatPreprocessingDroppedOrCoarsened) {
+  const Scan scan = scanTree("young_tall_spindle", 4, 0.003);
+  Points pts;
+  for (const auto& p : scan.cloud->points)
+    pts.emplace_back(p.x, p.y, p.z);
+  EXPECT_TRUE(TreeModeler(ModelerConfig{}).model(pts).notices.empty());
+  pts.emplace_back(1e7, 1e7, 1.0);
+  ModelerConfig capped;
+  capped.max_modeled_points = 20000;
+  const ModelResult result = TreeModeler(capped).model(pts);
+  ASSERT_EQ(result.notices.size(), 2u);
+  EXPECT_EQ(result.notices[0], "dropped 1 stray points far outside the cloud's bulk");
+  EXPECT_NE(result.notices[1].find(std::to_string(result.points.size()) + " points modeled on a "),
+            std::string::npos)
+      << result.notices[1];
+  EXPECT_NE(result.notices[1].find("max_modeled_points (20000)"), std::string::npos)
+      << result.notices[1];
+}
+
 TEST(TreeModeler, SameInputSameModel) {
   const Scan scan = scanTree("young_tall_spindle", 4, 0.003);
   const TreeModeler modeler(ModelerConfig{});

@@ -35,6 +35,9 @@ struct ModelResult {
   Points points;                    ///< the cloud the model was computed from (preprocessed)
   std::vector<PointClass> classes;  ///< one per entry of `points`
   PreprocessStats preprocess;
+  /// What preprocessing dropped or coarsened that the user should hear of (stray points far
+  /// from the bulk, a grid coarser than voxel_size): one sentence each, for the tool and the node
+  std::vector<std::string> notices;
   double noise_sigma = 0.0;  ///< range noise estimate used (m)
   double split_error = 0.0;  ///< e_t used (m)
   /// neighbourGrowthDimension of the modeled points: about 2 for scanned surfaces, 3 for a
