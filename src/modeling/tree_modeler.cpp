@@ -21,6 +21,7 @@
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/structure.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
+#include "dormant_tree_modeling/modeling/trunk_search.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -38,24 +39,6 @@ constexpr double MAX_STRUCTURE_DIMENSION = 2.5;
 // times the LMS111's specified 1-sigma statistical error, and more than a young branch's
 // radius, so no diameter would mean anything.
 constexpr double MAX_NOISE_SIGMA_M = 0.05;
-// A trunk track scores the points between these distances (m) beyond its surface: branches.
-// A post has none; a neighbour's branch is no vertical cylinder.
-constexpr double BRANCH_SHELL_INNER_M = 0.05;
-constexpr double BRANCH_SHELL_OUTER_M = 0.35;
-constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
-constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
-constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
-constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
-constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
-// A track whose top third is at least this share of its bottom third's radius does not taper:
-// a trellis post or a pole, scored at POLE_WEIGHT (a tree's trunk tapers; one post beside a
-// tree gathers the tree's branches in its shell and outscored the trunk on two test trees).
-constexpr double POLE_TAPER = 0.9;
-constexpr double POLE_WEIGHT = 0.5;
-constexpr double RETRY_WIDTH =
-    1.6;  // first circle / start radius above which a low track is retried
-constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
-
 class Stopwatch {
  public:
   explicit Stopwatch(std::vector<std::pair<std::string, double>>& out) : out_(out) {}
@@ -82,34 +65,6 @@ CylinderModel toModel(const Cylinder& c, int id, std::size_t inliers, std::size_
   return m;
 }
 
-/// Range-noise guess from a cluster's cylinder-fit residuals; the slices refine it later.
-double noiseGuess(const Points& pts, const Cluster& cluster) {
-  std::vector<double> res;
-  for (const int i : cluster.members)
-    res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
-  return noiseFromRadialResiduals(std::move(res));
-}
-
-/// Horizontal offsets of track b from track a at a's centres up to `below` (m), where b spans
-/// their height.
-std::vector<double> trackOffsets(const TrackedTrunk& a, const TrackedTrunk& b,
-                                 double below = std::numeric_limits<double>::infinity()) {
-  std::vector<double> out;
-  for (const auto& p : a.centers) {
-    if (p.z() > below)
-      break;
-    for (std::size_t i = 0; i + 1 < b.centers.size(); ++i) {
-      const Eigen::Vector3d &lo = b.centers[i], &hi = b.centers[i + 1];
-      if (p.z() < lo.z() || p.z() > hi.z() || hi.z() - lo.z() < 1e-9)
-        continue;
-      const double t = (p.z() - lo.z()) / (hi.z() - lo.z());
-      out.push_back((p.head<2>() - (lo + t * (hi - lo)).head<2>()).norm());
-      break;
-    }
-  }
-  return out;
-}
-
 /// What preprocessing did that the user should hear of, one sentence each.
 std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t modeled,
                                            const ModelerConfig& config) {
@@ -127,204 +82,6 @@ std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t
     out.emplace_back(text);
   }
   return out;
-}
-
-/// Ours: track the leader from every plausible trunk base (a sizeable, near-vertical cylinder
-/// piece near the bottom, Algorithm 2's start among them), group the tracks that stand on one
-/// base, and keep the trunk whose tracks have the most points around them between 5 and 35 cm
-/// from their axis: branches. A post has none, a neighbour's branch is no vertical cylinder.
-std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
-                                           const std::vector<Cluster>& clusters,
-                                           const TrunkPath& path, const ModelerConfig& config,
-                                           std::vector<TrunkCandidate>* report) {
-  double zmin = std::numeric_limits<double>::infinity();
-  double zmax = -std::numeric_limits<double>::infinity();
-  for (const auto& c : clusters) {
-    zmin = std::min(zmin, c.centroid.z());
-    zmax = std::max(zmax, c.centroid.z());
-  }
-  std::vector<int> candidates{path.trunk.front()};
-  for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
-    const auto& fit = clusters[c].fit;
-    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + TRUNK_BASE_BAND_M && fit &&
-        fit->radius < MAX_TRUNK_FIT_RADIUS_M &&
-        static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
-        std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0)) {
-      candidates.push_back(c);
-    }
-  }
-  // The target is the tree its crop centres on (the paper's hand crop, our scan assembler's
-  // isolation): a candidate's score fades with its distance from the cloud's horizontal centre.
-  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-  for (const auto& p : pts) {
-    lo = lo.cwiseMin(p.head<2>());
-    hi = hi.cwiseMax(p.head<2>());
-  }
-  const Eigen::Vector2d middle = 0.5 * (lo + hi);
-  // The circle band is the scanner's noise, one value for all candidates: the median of their
-  // fits' noise guesses (a fragment's own guess can be twice the noise, and a band that thick
-  // lets a small circle on the trunk's flank outscore the trunk's own).
-  std::vector<double> guesses;
-  for (const int c : candidates) {
-    if (clusters[c].fit)
-      guesses.push_back(noiseGuess(pts, clusters[c]));
-  }
-  const double threshold = std::max(0.5 * config.circle_threshold, noiseBand(median(guesses)));
-  // Candidates are tracked independently, on all cores; the best is chosen in candidate order.
-  std::vector<std::optional<TrackedTrunk>> tracks(candidates.size());
-  std::vector<double> scores(candidates.size(), -1.0);
-  parallelFor(static_cast<int>(candidates.size()), [&](int k) {
-    const int c = candidates[k];
-    if (!clusters[c].fit)
-      return;
-    const Cylinder& first = *clusters[c].fit;
-    const Eigen::Vector3d axis = first.axis.z() < 0.0 ? Eigen::Vector3d(-first.axis) : first.axis;
-    const Eigen::Vector3d start = first.center - 0.5 * first.length * axis;
-    // Tracking starts upright: a fragment's fitted axis can lean by tens of degrees, and an
-    // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
-    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-    TrackedTrunk tracked = trackTrunk(pts, index, start, up, first.radius, threshold, config);
-    // The free first circle can take in what stands around the base (suckers, weeds, soil
-    // pixels) and set a radius the trunk above never matches: a track that stops low after a
-    // first circle much wider than its start cluster is tried again from the cluster's own
-    // radius, and the one that climbs higher is kept.
-    const auto climb = [&](const TrackedTrunk& t) {
-      return t.centers.empty() ? 0.0 : t.centers.back().z() - start.z();
-    };
-    const bool wide_first =
-        tracked.radii.empty() || tracked.radii.front() > RETRY_WIDTH * first.radius;
-    if (wide_first && climb(tracked) < 0.5 * (zmax - start.z())) {
-      TrackedTrunk retry =
-          trackTrunk(pts, index, start, up, first.radius, threshold, config, 4, true);
-      if (climb(retry) > climb(tracked))
-        tracked = std::move(retry);
-    }
-    if (tracked.centers.size() < 3)
-      return;
-    // And down to the ground: where the first cluster begins is an accident of k-means.
-    const TrackedTrunk down = trackTrunk(pts, index, tracked.centers.front(), -up,
-                                         tracked.radii.front(), threshold, config);
-    tracked.centers.insert(tracked.centers.begin(), down.centers.rbegin(), down.centers.rend());
-    tracked.radii.insert(tracked.radii.begin(), down.radii.rbegin(), down.radii.rend());
-    double shell = 0.0;
-    for (std::size_t k2 = 0; k2 < tracked.centers.size(); k2 += 2) {
-      const double r = tracked.radii[k2];
-      shell += index.countWithin(tracked.centers[k2], r + BRANCH_SHELL_OUTER_M, 1 << 20) -
-               index.countWithin(tracked.centers[k2], r + BRANCH_SHELL_INNER_M, 1 << 20);
-    }
-    const double off_centre = (start.head<2>() - middle).norm() / CENTRE_PRIOR_SCALE;
-    // A trunk stands on the ground: a track whose lowest slice floats above the cloud's
-    // bottom is a branch or the leader's top half, whatever the branches around it.
-    double lowest = 1e300;
-    for (const auto& p : tracked.centers)
-      lowest = std::min(lowest, p.z());
-    const double floating = std::max(0.0, lowest - (zmin + GROUND_REACH)) / GROUND_REACH;
-    const std::size_t third = tracked.radii.size() / 3;
-    double pole = 1.0;
-    if (third >= 3) {
-      const std::vector<double> lower(tracked.radii.begin(), tracked.radii.begin() + third);
-      const std::vector<double> upper(tracked.radii.end() - third, tracked.radii.end());
-      if (median(upper) >= POLE_TAPER * median(lower))
-        pole = POLE_WEIGHT;
-    }
-    scores[k] = pole * shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
-    tracks[k] = std::move(tracked);
-  });
-  // Tracks from bases on one trunk follow one axis, except where one strays into a branch
-  // (and scores high among the branches). Tracks that stand on one base (median offset over
-  // their lowest BASE_HEIGHT below a radius) are one trunk; a trunk scores the median of its
-  // tracks, and is represented by the track that strays least from the others.
-  const int m = static_cast<int>(candidates.size());
-  std::vector<std::vector<double>> mean_offset(m, std::vector<double>(m, 0.0));
-  std::vector<int> group(m, -1);
-  for (int a = 0; a < m; ++a) {
-    if (!tracks[a])
-      continue;
-    if (group[a] < 0)
-      group[a] = a;
-    for (int b = a + 1; b < m; ++b) {
-      if (!tracks[b])
-        continue;
-      const auto offsets = trackOffsets(*tracks[a], *tracks[b]);
-      mean_offset[a][b] = mean_offset[b][a] =
-          offsets.size() < 4
-              ? std::numeric_limits<double>::infinity()
-              : std::accumulate(offsets.begin(), offsets.end(), 0.0) / offsets.size();
-      const auto base =
-          trackOffsets(*tracks[a], *tracks[b], tracks[a]->centers.front().z() + BASE_HEIGHT);
-      const double same =
-          std::max(SAME_TRUNK_MIN, std::min(median(tracks[a]->radii), median(tracks[b]->radii)));
-      if (group[b] < 0 && base.size() >= 3 && median(base) < same)
-        group[b] = group[a];
-    }
-  }
-  int chosen = -1;
-  double best_score = -1.0;
-  for (int g = 0; g < m; ++g) {
-    // Only the tracks that climb most of the group's height vote: a track that stopped at a
-    // whorl low on the trunk has a small shell and would drag its trunk below a neighbour's.
-    double group_top = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < m; ++k) {
-      if (group[k] == g)
-        group_top = std::max(group_top, tracks[k]->centers.back().z());
-    }
-    std::vector<double> member_scores;
-    for (int k = 0; k < m; ++k) {
-      if (group[k] == g &&
-          tracks[k]->centers.back().z() - zmin >= VOTING_HEIGHT * (group_top - zmin))
-        member_scores.push_back(scores[k]);
-    }
-    if (member_scores.empty())
-      continue;
-    const double score = median(member_scores);
-    if (score <= best_score)
-      continue;
-    best_score = score;
-    // Among tracks that stray alike (within STRAY_TIE per other track; two tracks always
-    // stray alike), the one reaching highest: a track can stop early at a whorl.
-    std::vector<double> stray(m, std::numeric_limits<double>::infinity());
-    double least = std::numeric_limits<double>::infinity();
-    int others = -1;
-    for (int k = 0; k < m; ++k) {
-      if (group[k] != g)
-        continue;
-      ++others;
-      stray[k] = 0.0;
-      for (int o = 0; o < m; ++o) {
-        if (o != k && group[o] == g)
-          stray[k] += std::min(mean_offset[k][o], 1.0);
-      }
-      least = std::min(least, stray[k]);
-    }
-    double highest = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < m; ++k) {
-      if (group[k] == g && stray[k] <= least + STRAY_TIE * others &&
-          tracks[k]->centers.back().z() > highest) {
-        highest = tracks[k]->centers.back().z();
-        chosen = k;
-      }
-    }
-  }
-  report->assign(candidates.size(), TrunkCandidate{});
-  for (int k = 0; k < m; ++k) {
-    TrunkCandidate& r = (*report)[k];
-    if (const auto& fit = clusters[candidates[k]].fit) {
-      r.start = fit->center;
-      r.start_radius = fit->radius;
-    }
-    if (!tracks[k])
-      continue;
-    r.slices = static_cast<int>(tracks[k]->centers.size());
-    r.bottom = tracks[k]->centers.front().z();
-    r.top = tracks[k]->centers.back().z();
-    r.median_radius = median(tracks[k]->radii);
-    r.score = scores[k];
-    r.group = group[k];
-  }
-  if (chosen < 0)
-    return std::nullopt;
-  (*report)[chosen].chosen = true;
-  return std::move(tracks[chosen]);
 }
 
 /// How far outside a calibration's covered radii and noise a tree may go before the model says

@@ -114,11 +114,11 @@ int main(int argc, char** argv) {
         std::cerr << " " << reason << " " << n << ";";
       std::cerr << "\n";
       for (const auto& c : result.trunk_candidates) {
-        std::cerr << "  trunk candidate at (" << c.start.x() << ", " << c.start.y() << ", "
-                  << c.start.z() << ") r " << 1000.0 * c.start_radius << " mm: " << c.slices
-                  << " circles, z " << c.bottom << ".." << c.top << ", median r "
-                  << 1000.0 * c.median_radius << " mm, score " << c.score << ", trunk " << c.group
-                  << (c.chosen ? "  <- trunk" : "") << "\n";
+        std::cerr << "  trunk candidate " << (c.from_column ? "(density column) " : "") << "at ("
+                  << c.start.x() << ", " << c.start.y() << ", " << c.start.z() << ") r "
+                  << 1000.0 * c.start_radius << " mm: " << c.slices << " circles, z " << c.bottom
+                  << ".." << c.top << ", median r " << 1000.0 * c.median_radius << " mm, score "
+                  << c.score << ", trunk " << c.group << (c.chosen ? "  <- trunk" : "") << "\n";
       }
     }
     std::cout << "tree_model: " << result.model.trunk.size() << " trunk cylinders, "

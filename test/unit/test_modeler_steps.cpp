@@ -14,6 +14,7 @@
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/taper_profile.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
+#include "dormant_tree_modeling/modeling/trunk_search.h"
 #include "temp_dir.h"
 
 namespace dormant_tree_modeling {
@@ -265,6 +266,61 @@ TEST(TrunkTracking, AStartOnTheFlankWithASmallGuessFindsTheWholeTrunk) {
     EXPECT_LT(track.centers[k].head<2>().norm(), 0.015) << "slice " << k;
     EXPECT_NEAR(track.radii[k], 0.08, 0.015) << "slice " << k;
   }
+}
+
+TEST(TrunkSearch, ADenseColumnAwayFromTheStartsIsAStart) {
+  // Two trunks (r 4 cm, 0.5 m tall) and a thin sheet of smeared returns: the one at (1, 0)
+  // already has a start, the one at (0, 0) gets a column start at its foot; the sheet, spread
+  // over 40 x 40 cm, is no column.
+  Points pts;
+  addCylinder(pts, {0, 0, 0.05}, {0, 0, 1}, 0.04, 0.5);
+  addCylinder(pts, {1, 0, 0.05}, {0, 0, 1}, 0.04, 0.5);
+  Rng rng(3);
+  for (int i = 0; i < 600; ++i)
+    pts.emplace_back(rng.uniform(-0.7, -0.3), rng.uniform(-0.2, 0.2), rng.uniform(0.1, 0.12));
+  TrunkStart existing;
+  existing.base = {1.01, 0.0, 0.05};
+  existing.radius = 0.04;
+  ModelerConfig config;
+  const auto starts = densityColumnStarts(pts, 0.1, {existing}, 0.03, config);
+  ASSERT_EQ(starts.size(), 1u);
+  EXPECT_TRUE(starts[0].from_column);
+  EXPECT_LT(starts[0].base.head<2>().norm(), 0.03);
+  EXPECT_NEAR(starts[0].base.z(), 0.05, 1e-9);
+  EXPECT_DOUBLE_EQ(starts[0].radius, 0.03);
+  EXPECT_TRUE(densityColumnStarts(pts, 0.1, {existing, starts[0]}, 0.03, config).empty());
+}
+
+TEST(TrunkSearch, ATrunkWhoseFootClustersLieFlatIsFoundFromItsColumn) {
+  // A trunk (r 4 cm, 1.5 m) with a whorl of branches, whose lowest cluster's fit lies on its
+  // side (as behind-the-trunk mixed pixels make it), and a post 0.5 m away whose fit stands:
+  // the trunk's column is tracked and outscores the post.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.04, 1.5);
+  for (int b = 0; b < 4; ++b) {
+    const double phi = b * M_PI / 2 + 0.3;
+    addCylinder(pts, {0, 0, 0.7 + 0.15 * b}, {std::cos(phi), std::sin(phi), 0.3}, 0.012, 0.5);
+  }
+  const int tree_points = static_cast<int>(pts.size());
+  addCylinder(pts, {0.5, 0.3, 0}, {0, 0, 1}, 0.04, 1.5);
+  std::vector<Cluster> clusters(2);
+  clusters[0].centroid = {0, 0, 0.1};
+  clusters[0].fit = Cylinder{{0, 0, 0.1}, {1, 0, 0}, 0.03, 0.3};
+  clusters[0].members.resize(200);
+  clusters[1] = clusterOf(pts, tree_points, static_cast<int>(pts.size()));
+  clusters[1].centroid.z() = 0.1;
+  TrunkPath path;
+  path.trunk = {1};
+  const PointIndex index(pts);
+  ModelerConfig config;
+  std::vector<TrunkCandidate> report;
+  const auto best = trackBestTrunk(pts, index, clusters, path, config, &report);
+  ASSERT_TRUE(best);
+  EXPECT_LT(best->centers.front().head<2>().norm(), 0.02);
+  EXPECT_GT(best->centers.back().z(), 1.2);
+  ASSERT_EQ(report.size(), 2u);
+  EXPECT_TRUE(report[1].from_column);
+  EXPECT_TRUE(report[1].chosen);
 }
 
 TEST(TrunkModel, ALeaderThatBendsIsSplitWhereItLeavesTheChord) {

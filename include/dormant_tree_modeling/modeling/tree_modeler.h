@@ -10,24 +10,13 @@
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/preprocess.h"
 #include "dormant_tree_modeling/modeling/tree_model.h"
+#include "dormant_tree_modeling/modeling/trunk_search.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
 
 /// @brief Per-point class of the modeled (downsampled, cleaned) cloud.
 enum class PointClass : std::uint8_t { OTHER = 0, TRUNK = 1, PRIMARY = 2 };
-
-/// @brief One trunk base the modeler tracked (ours, ours_follow_diameter), for diagnostics.
-struct TrunkCandidate {
-  Eigen::Vector3d start = Eigen::Vector3d::Zero();  ///< where tracking began
-  double start_radius = 0.0;                        ///< the start cluster's fitted radius (m)
-  int slices = 0;                  ///< circles along the track (0: it did not take)
-  double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
-  double median_radius = 0.0;      ///< of the track's circles (m)
-  double score = -1.0;             ///< branch points around it, weighted
-  int group = -1;                  ///< candidates whose tracks follow one trunk share a group
-  bool chosen = false;             ///< the track that became the trunk's axis
-};
 
 /// @brief Everything one modeling run produced.
 struct ModelResult {

@@ -1,0 +1,68 @@
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "dormant_tree_modeling/common/cloud.h"
+#include "dormant_tree_modeling/modeling/cluster_graph.h"
+#include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+/// @brief One trunk base the modeler tracked (ours, ours_follow_diameter), for diagnostics.
+struct TrunkCandidate {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();  ///< where tracking began
+  double start_radius = 0.0;       ///< the start's radius guess (m): its cluster's fitted radius
+  bool from_column = false;        ///< a dense column of points, not a cluster, gave the start
+  int slices = 0;                  ///< circles along the track (0: it did not take)
+  double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
+  double median_radius = 0.0;      ///< of the track's circles (m)
+  double score = -1.0;             ///< branch points around it, weighted
+  int group = -1;                  ///< candidates whose tracks follow one trunk share a group
+  bool chosen = false;             ///< the track that became the trunk's axis
+};
+
+/// @brief Where a trunk track may begin.
+struct TrunkStart {
+  Eigen::Vector3d base = Eigen::Vector3d::Zero();    ///< lowest point of the start (m)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< the start's centre, reported (m)
+  double radius = 0.0;                               ///< radius guess (m)
+  bool from_column = false;                          ///< see TrunkCandidate::from_column
+  int cluster = -1;                                  ///< the start's cluster, -1 for a column
+  bool usable = true;  ///< false: Algorithm 2's trunk start without a cylinder fit
+};
+
+/// @brief Trunk starts from the clusters: Algorithm 2's trunk start first, then every sizeable
+/// near-vertical cylinder fit in the lowest TRUNK_BASE_BAND_M of the clusters.
+/// @param zmin the lowest cluster centroid's z (m)
+std::vector<TrunkStart> clusterTrunkStarts(const std::vector<Cluster>& clusters,
+                                           const TrunkPath& path, double zmin,
+                                           const ModelerConfig& config);
+
+/// @brief Trunk starts at the densest columns of points in the lowest TRUNK_BASE_BAND_M (above
+/// `zmin`) that no start in `existing` stands within TRUNK_COLUMN_SEPARATION_M of: a trunk
+/// whose lowest clusters are flat slabs (mixed pixels smear a scanner's returns behind a trunk
+/// into wide, thin clusters, whose cylinder fits lie on their side) still stands as a column.
+/// @param radius the starts' radius guess (m); the first circle of a track is free anyway
+std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
+                                            const std::vector<TrunkStart>& existing, double radius,
+                                            const ModelerConfig& config);
+
+/// @brief Ours: track the leader from every plausible trunk base (the cluster starts and the
+/// dense columns), group the tracks that stand on one base, and keep the trunk whose tracks
+/// have the most points around them between 5 and 35 cm from their axis: branches. A post has
+/// none, a neighbour's branch is no vertical cylinder.
+/// @param report filled with one entry per start
+std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
+                                           const std::vector<Cluster>& clusters,
+                                           const TrunkPath& path, const ModelerConfig& config,
+                                           std::vector<TrunkCandidate>* report);
+
+/// @brief Columns closer than this (m, horizontally) to a start are that start's trunk.
+constexpr double TRUNK_COLUMN_SEPARATION_M = 0.15;
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling

@@ -1,0 +1,490 @@
+#include "dormant_tree_modeling/modeling/trunk_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+#include "dormant_tree_modeling/common/parallel.h"
+#include "dormant_tree_modeling/common/statistics.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
+#include "dormant_tree_modeling/modeling/noise_bias.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+
+namespace {
+
+// A trunk track scores the points between these distances (m) beyond its surface: branches.
+// A post has none; a neighbour's branch is no vertical cylinder.
+constexpr double BRANCH_SHELL_INNER_M = 0.05;
+constexpr double BRANCH_SHELL_OUTER_M = 0.35;
+constexpr double CENTRE_PRIOR_SCALE = 0.5;  // m
+constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trunk track reaches
+constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
+constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
+constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
+// A track whose top third is at least this share of its bottom third's radius does not taper:
+// a trellis post or a pole, scored at POLE_WEIGHT (a tree's trunk tapers; one post beside a
+// tree gathers the tree's branches in its shell and outscored the trunk on two test trees).
+constexpr double POLE_TAPER = 0.9;
+constexpr double POLE_WEIGHT = 0.5;
+constexpr double RETRY_WIDTH = 1.6;     // first circle / start radius above which a low track
+                                        // is retried
+constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
+// Density columns: points counted on a COLUMN_CELL_M grid and summed over a square of
+// 2 COLUMN_HALF_CELLS + 1 cells (10 cm, a young trunk's diameter and more); at most
+// COLUMN_STARTS of them are tried.
+constexpr double COLUMN_CELL_M = 0.02;
+constexpr int COLUMN_HALF_CELLS = 2;
+constexpr int COLUMN_STARTS = 3;
+// A start whose track climbs this share of the clusters' height above it stands on a trunk.
+constexpr double STANDING_CLIMB = 0.5;
+
+/// Range-noise guess from a cluster's cylinder-fit residuals; the slices refine it later.
+double noiseGuess(const Points& pts, const Cluster& cluster) {
+  std::vector<double> res;
+  for (const int i : cluster.members)
+    res.push_back(axisDistance(*cluster.fit, pts[i]) - cluster.fit->radius);
+  return noiseFromRadialResiduals(std::move(res));
+}
+
+/// Horizontal offsets of track b from track a at a's centres up to `below` (m), where b spans
+/// their height.
+std::vector<double> trackOffsets(const TrackedTrunk& a, const TrackedTrunk& b,
+                                 double below = std::numeric_limits<double>::infinity()) {
+  std::vector<double> out;
+  for (const auto& p : a.centers) {
+    if (p.z() > below)
+      break;
+    for (std::size_t i = 0; i + 1 < b.centers.size(); ++i) {
+      const Eigen::Vector3d &lo = b.centers[i], &hi = b.centers[i + 1];
+      if (p.z() < lo.z() || p.z() > hi.z() || hi.z() - lo.z() < 1e-9)
+        continue;
+      const double t = (p.z() - lo.z()) / (hi.z() - lo.z());
+      out.push_back((p.head<2>() - (lo + t * (hi - lo)).head<2>()).norm());
+      break;
+    }
+  }
+  return out;
+}
+
+/// What every track is measured against: the clusters' height range and the cloud's
+/// horizontal centre (the target is the tree its crop centres on: the paper's hand crop, our
+/// scan assembler's isolation).
+struct SearchFrame {
+  double zmin = std::numeric_limits<double>::infinity();
+  double zmax = -std::numeric_limits<double>::infinity();
+  Eigen::Vector2d middle = Eigen::Vector2d::Zero();
+};
+
+SearchFrame searchFrame(const Points& pts, const std::vector<Cluster>& clusters) {
+  SearchFrame f;
+  for (const auto& c : clusters) {
+    f.zmin = std::min(f.zmin, c.centroid.z());
+    f.zmax = std::max(f.zmax, c.centroid.z());
+  }
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const auto& p : pts) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  f.middle = 0.5 * (lo + hi);
+  return f;
+}
+
+/// The circle band is the scanner's noise, one value for all starts: the median of the
+/// start clusters' noise guesses (a fragment's own guess can be twice the noise, and a band
+/// that thick lets a small circle on the trunk's flank outscore the trunk's own).
+double trackingThreshold(const Points& pts, const std::vector<Cluster>& clusters,
+                         const std::vector<TrunkStart>& starts, const ModelerConfig& config) {
+  std::vector<double> guesses;
+  for (const auto& s : starts) {
+    if (s.cluster >= 0 && clusters[s.cluster].fit)
+      guesses.push_back(noiseGuess(pts, clusters[s.cluster]));
+  }
+  return std::max(0.5 * config.circle_threshold, noiseBand(median(guesses)));
+}
+
+/// Up from the start, retried from the start's own radius when a wide first circle stopped it
+/// low, then down to the ground.
+TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkStart& start,
+                       double threshold, double zmax, const ModelerConfig& config) {
+  // Tracking starts upright: a fragment's fitted axis can lean by tens of degrees, and an
+  // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  TrackedTrunk tracked = trackTrunk(pts, index, start.base, up, start.radius, threshold, config);
+  // The free first circle can take in what stands around the base (suckers, weeds, soil
+  // pixels) and set a radius the trunk above never matches: a track that stops low after a
+  // first circle much wider than its start is tried again from the start's own radius, and
+  // the one that climbs higher is kept.
+  const auto climb = [&](const TrackedTrunk& t) {
+    return t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
+  };
+  const bool wide_first =
+      tracked.radii.empty() || tracked.radii.front() > RETRY_WIDTH * start.radius;
+  if (wide_first && climb(tracked) < 0.5 * (zmax - start.base.z())) {
+    TrackedTrunk retry =
+        trackTrunk(pts, index, start.base, up, start.radius, threshold, config, 4, true);
+    if (climb(retry) > climb(tracked))
+      tracked = std::move(retry);
+  }
+  if (tracked.centers.size() < 3)
+    return tracked;
+  // And down to the ground: where the first cluster begins is an accident of k-means.
+  const TrackedTrunk down = trackTrunk(pts, index, tracked.centers.front(), -up,
+                                       tracked.radii.front(), threshold, config);
+  tracked.centers.insert(tracked.centers.begin(), down.centers.rbegin(), down.centers.rend());
+  tracked.radii.insert(tracked.radii.begin(), down.radii.rbegin(), down.radii.rend());
+  return tracked;
+}
+
+/// Branch points in the shell around a track, weighted down for a start far from the crop's
+/// centre, a track floating above the ground and one that does not taper (a post).
+double trackScore(const PointIndex& index, const TrackedTrunk& tracked, const TrunkStart& start,
+                  const SearchFrame& frame) {
+  double shell = 0.0;
+  for (std::size_t k = 0; k < tracked.centers.size(); k += 2) {
+    const double r = tracked.radii[k];
+    shell += index.countWithin(tracked.centers[k], r + BRANCH_SHELL_OUTER_M, 1 << 20) -
+             index.countWithin(tracked.centers[k], r + BRANCH_SHELL_INNER_M, 1 << 20);
+  }
+  const double off_centre = (start.base.head<2>() - frame.middle).norm() / CENTRE_PRIOR_SCALE;
+  // A trunk stands on the ground: a track whose lowest slice floats above the cloud's
+  // bottom is a branch or the leader's top half, whatever the branches around it.
+  double lowest = 1e300;
+  for (const auto& p : tracked.centers)
+    lowest = std::min(lowest, p.z());
+  const double floating = std::max(0.0, lowest - (frame.zmin + GROUND_REACH)) / GROUND_REACH;
+  const std::size_t third = tracked.radii.size() / 3;
+  double pole = 1.0;
+  if (third >= 3) {
+    const std::vector<double> lower(tracked.radii.begin(), tracked.radii.begin() + third);
+    const std::vector<double> upper(tracked.radii.end() - third, tracked.radii.end());
+    if (median(upper) >= POLE_TAPER * median(lower))
+      pole = POLE_WEIGHT;
+  }
+  return pole * shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
+}
+
+/// Tracks that stand on one base (median offset over their lowest BASE_HEIGHT below a radius)
+/// are one trunk: a group index per track (-1 for none), and the tracks' mean offsets.
+struct TrackGroups {
+  std::vector<int> group;
+  std::vector<std::vector<double>> mean_offset;
+};
+
+TrackGroups groupTracks(const std::vector<std::optional<TrackedTrunk>>& tracks) {
+  const int m = static_cast<int>(tracks.size());
+  TrackGroups g;
+  g.mean_offset.assign(m, std::vector<double>(m, 0.0));
+  g.group.assign(m, -1);
+  for (int a = 0; a < m; ++a) {
+    if (!tracks[a])
+      continue;
+    if (g.group[a] < 0)
+      g.group[a] = a;
+    for (int b = a + 1; b < m; ++b) {
+      if (!tracks[b])
+        continue;
+      const auto offsets = trackOffsets(*tracks[a], *tracks[b]);
+      g.mean_offset[a][b] = g.mean_offset[b][a] =
+          offsets.size() < 4
+              ? std::numeric_limits<double>::infinity()
+              : std::accumulate(offsets.begin(), offsets.end(), 0.0) / offsets.size();
+      const auto base =
+          trackOffsets(*tracks[a], *tracks[b], tracks[a]->centers.front().z() + BASE_HEIGHT);
+      const double same =
+          std::max(SAME_TRUNK_MIN, std::min(median(tracks[a]->radii), median(tracks[b]->radii)));
+      if (g.group[b] < 0 && base.size() >= 3 && median(base) < same)
+        g.group[b] = g.group[a];
+    }
+  }
+  return g;
+}
+
+/// A group's representative: among its tracks that stray alike from the others (within
+/// STRAY_TIE per other track; two tracks always stray alike), the one reaching highest, since
+/// a track can stop early at a whorl.
+int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const TrackGroups& g,
+                   int group) {
+  const int m = static_cast<int>(tracks.size());
+  std::vector<double> stray(m, std::numeric_limits<double>::infinity());
+  double least = std::numeric_limits<double>::infinity();
+  int others = -1;
+  for (int k = 0; k < m; ++k) {
+    if (g.group[k] != group)
+      continue;
+    ++others;
+    stray[k] = 0.0;
+    for (int o = 0; o < m; ++o) {
+      if (o != k && g.group[o] == group)
+        stray[k] += std::min(g.mean_offset[k][o], 1.0);
+    }
+    least = std::min(least, stray[k]);
+  }
+  int chosen = -1;
+  double highest = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < m; ++k) {
+    if (g.group[k] == group && stray[k] <= least + STRAY_TIE * others &&
+        tracks[k]->centers.back().z() > highest) {
+      highest = tracks[k]->centers.back().z();
+      chosen = k;
+    }
+  }
+  return chosen;
+}
+
+/// The best group scores the median of its voting tracks: only those that climb most of the
+/// group's height vote, since a track that stopped at a whorl low on the trunk has a small
+/// shell and would drag its trunk below a neighbour's. Returns its representative, or -1.
+int chooseTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                const std::vector<double>& scores, const TrackGroups& g, double zmin) {
+  const int m = static_cast<int>(tracks.size());
+  int chosen = -1;
+  double best_score = -1.0;
+  for (int group = 0; group < m; ++group) {
+    double group_top = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < m; ++k) {
+      if (g.group[k] == group)
+        group_top = std::max(group_top, tracks[k]->centers.back().z());
+    }
+    std::vector<double> member_scores;
+    for (int k = 0; k < m; ++k) {
+      if (g.group[k] == group &&
+          tracks[k]->centers.back().z() - zmin >= VOTING_HEIGHT * (group_top - zmin))
+        member_scores.push_back(scores[k]);
+    }
+    if (member_scores.empty())
+      continue;
+    const double score = median(member_scores);
+    if (score <= best_score)
+      continue;
+    best_score = score;
+    chosen = representative(tracks, g, group);
+  }
+  return chosen;
+}
+
+std::vector<TrunkCandidate> candidateReport(const std::vector<TrunkStart>& starts,
+                                            const std::vector<std::optional<TrackedTrunk>>& tracks,
+                                            const std::vector<double>& scores, const TrackGroups& g,
+                                            int chosen) {
+  std::vector<TrunkCandidate> report(starts.size());
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    TrunkCandidate& r = report[k];
+    r.from_column = starts[k].from_column;
+    if (starts[k].usable) {
+      r.start = starts[k].centre;
+      r.start_radius = starts[k].radius;
+    }
+    if (!tracks[k])
+      continue;
+    r.slices = static_cast<int>(tracks[k]->centers.size());
+    r.bottom = tracks[k]->centers.front().z();
+    r.top = tracks[k]->centers.back().z();
+    r.median_radius = median(tracks[k]->radii);
+    r.score = scores[k];
+    r.group = g.group[k];
+    r.chosen = static_cast<int>(k) == chosen;
+  }
+  return report;
+}
+
+/// Cells of the column grid, keyed by their two indices.
+struct CellKey {
+  std::int64_t x, y;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y; }
+};
+struct CellKeyHash {
+  std::size_t operator()(const CellKey& k) const {
+    return std::hash<std::int64_t>()(k.x * 73856093) ^ std::hash<std::int64_t>()(k.y * 19349663);
+  }
+};
+struct ColumnCell {
+  int count = 0;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  double lowest = std::numeric_limits<double>::infinity();
+  int smoothed = 0;
+};
+
+}  // namespace
+
+std::vector<TrunkStart> clusterTrunkStarts(const std::vector<Cluster>& clusters,
+                                           const TrunkPath& path, double zmin,
+                                           const ModelerConfig& config) {
+  std::vector<int> picked{path.trunk.front()};
+  for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
+    const auto& fit = clusters[c].fit;
+    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + TRUNK_BASE_BAND_M && fit &&
+        fit->radius < MAX_TRUNK_FIT_RADIUS_M &&
+        static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
+        std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0))
+      picked.push_back(c);
+  }
+  std::vector<TrunkStart> out;
+  for (const int c : picked) {
+    TrunkStart s;
+    s.cluster = c;
+    const auto& fit = clusters[c].fit;
+    s.usable = fit.has_value();
+    if (fit) {
+      const Eigen::Vector3d axis = fit->axis.z() < 0.0 ? Eigen::Vector3d(-fit->axis) : fit->axis;
+      s.base = fit->center - 0.5 * fit->length * axis;
+      s.centre = fit->center;
+      s.radius = fit->radius;
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
+                                            const std::vector<TrunkStart>& existing, double radius,
+                                            const ModelerConfig& config) {
+  std::unordered_map<CellKey, ColumnCell, CellKeyHash> cells;
+  const double top = zmin + TRUNK_BASE_BAND_M;
+  for (const auto& p : pts) {
+    if (p.z() > top)
+      continue;
+    ColumnCell& c = cells[CellKey{static_cast<std::int64_t>(std::floor(p.x() / COLUMN_CELL_M)),
+                                  static_cast<std::int64_t>(std::floor(p.y() / COLUMN_CELL_M))}];
+    ++c.count;
+    c.sum += p.head<2>();
+    c.lowest = std::min(c.lowest, p.z());
+  }
+  std::vector<std::pair<CellKey, ColumnCell*>> order;
+  for (auto& [key, cell] : cells) {
+    for (int dx = -COLUMN_HALF_CELLS; dx <= COLUMN_HALF_CELLS; ++dx) {
+      for (int dy = -COLUMN_HALF_CELLS; dy <= COLUMN_HALF_CELLS; ++dy) {
+        const auto it = cells.find(CellKey{key.x + dx, key.y + dy});
+        if (it != cells.end())
+          cell.smoothed += it->second.count;
+      }
+    }
+    order.emplace_back(key, &cell);
+  }
+  // Densest first; ties in grid order, so the result does not depend on the hash.
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+    if (a.second->smoothed != b.second->smoothed)
+      return a.second->smoothed > b.second->smoothed;
+    return a.first.x != b.first.x ? a.first.x < b.first.x : a.first.y < b.first.y;
+  });
+  // A column is the densest cell within TRUNK_COLUMN_SEPARATION_M; those near a start taken
+  // already (a cluster's, a denser column's) belong to its trunk.
+  std::vector<Eigen::Vector2d> taken;
+  for (const auto& s : existing) {
+    if (s.usable)
+      taken.push_back(s.base.head<2>());
+  }
+  std::vector<Eigen::Vector2d> peaks;
+  std::vector<TrunkStart> out;
+  for (const auto& [key, cell] : order) {
+    if (cell->smoothed < 2 * config.min_cluster_points ||
+        static_cast<int>(out.size()) >= COLUMN_STARTS)
+      break;
+    const Eigen::Vector2d xy((key.x + 0.5) * COLUMN_CELL_M, (key.y + 0.5) * COLUMN_CELL_M);
+    const auto near = [&](const Eigen::Vector2d& q) {
+      return (q - xy).norm() < TRUNK_COLUMN_SEPARATION_M;
+    };
+    const bool shadowed = std::any_of(peaks.begin(), peaks.end(), near);
+    peaks.push_back(xy);
+    if (shadowed || std::any_of(taken.begin(), taken.end(), near))
+      continue;
+    // The start is the column's centroid at its lowest point: seen from all around, a trunk's
+    // returns centre on its axis.
+    double lowest = std::numeric_limits<double>::infinity();
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int dx = -COLUMN_HALF_CELLS; dx <= COLUMN_HALF_CELLS; ++dx) {
+      for (int dy = -COLUMN_HALF_CELLS; dy <= COLUMN_HALF_CELLS; ++dy) {
+        const auto it = cells.find(CellKey{key.x + dx, key.y + dy});
+        if (it != cells.end()) {
+          lowest = std::min(lowest, it->second.lowest);
+          sum += it->second.sum;
+        }
+      }
+    }
+    const Eigen::Vector2d centroid = sum / cell->smoothed;
+    TrunkStart s;
+    s.base = Eigen::Vector3d(centroid.x(), centroid.y(), lowest);
+    s.centre = s.base;
+    s.radius = radius;
+    s.from_column = true;
+    out.push_back(s);
+  }
+  return out;
+}
+
+namespace {
+
+/// Tracks and scores of starts[from..]: independent, on all cores.
+void trackStarts(const Points& pts, const PointIndex& index, const std::vector<TrunkStart>& starts,
+                 std::size_t from, double threshold, const SearchFrame& frame,
+                 const ModelerConfig& config, std::vector<std::optional<TrackedTrunk>>* tracks,
+                 std::vector<double>* scores) {
+  tracks->resize(starts.size());
+  scores->resize(starts.size(), -1.0);
+  parallelFor(static_cast<int>(starts.size() - from), [&](int i) {
+    const std::size_t k = from + i;
+    if (!starts[k].usable)
+      return;
+    TrackedTrunk tracked = climbFrom(pts, index, starts[k], threshold, frame.zmax, config);
+    if (tracked.centers.size() < 3)
+      return;
+    (*scores)[k] = trackScore(index, tracked, starts[k], frame);
+    (*tracks)[k] = std::move(tracked);
+  });
+}
+
+/// The starts whose tracks climb at least half of the clouds' height above them: what stands
+/// near one is its trunk. A start whose track stopped low (on a wide clutter arc by a trunk's
+/// foot) explains no column.
+std::vector<TrunkStart> standingStarts(const std::vector<TrunkStart>& starts,
+                                       const std::vector<std::optional<TrackedTrunk>>& tracks,
+                                       const SearchFrame& frame) {
+  std::vector<TrunkStart> out;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    if (tracks[k] && tracks[k]->centers.back().z() - starts[k].base.z() >=
+                         STANDING_CLIMB * (frame.zmax - starts[k].base.z()))
+      out.push_back(starts[k]);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
+                                           const std::vector<Cluster>& clusters,
+                                           const TrunkPath& path, const ModelerConfig& config,
+                                           std::vector<TrunkCandidate>* report) {
+  const SearchFrame frame = searchFrame(pts, clusters);
+  std::vector<TrunkStart> starts = clusterTrunkStarts(clusters, path, frame.zmin, config);
+  const double threshold = trackingThreshold(pts, clusters, starts, config);
+  std::vector<std::optional<TrackedTrunk>> tracks;
+  std::vector<double> scores;
+  trackStarts(pts, index, starts, 0, threshold, frame, config, &tracks, &scores);
+  // Then the dense columns that no standing track explains, in the same start order.
+  std::vector<double> radii;
+  for (const auto& s : starts) {
+    if (s.usable)
+      radii.push_back(s.radius);
+  }
+  if (!radii.empty()) {
+    const std::size_t from = starts.size();
+    const auto columns = densityColumnStarts(pts, frame.zmin, standingStarts(starts, tracks, frame),
+                                             median(radii), config);
+    starts.insert(starts.end(), columns.begin(), columns.end());
+    trackStarts(pts, index, starts, from, threshold, frame, config, &tracks, &scores);
+  }
+  const TrackGroups groups = groupTracks(tracks);
+  const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
+  *report = candidateReport(starts, tracks, scores, groups, chosen);
+  if (chosen < 0)
+    return std::nullopt;
+  return std::move(tracks[chosen]);
+}
+
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
