@@ -145,6 +145,175 @@ DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeMod
   return d;
 }
 
+/// Drops non-finite points (a copy only when there are some: a whole scan is hundreds of MB)
+/// and preprocesses the rest into result->points, ->preprocess and ->notices.
+/// @throws Error EMPTY_INPUT with fewer than MIN_POINTS before or after
+void preprocessInput(const Points& input, const ModelerConfig& config, ModelResult* result) {
+  std::size_t finite = 0;
+  for (const auto& p : input)
+    finite += p.allFinite();
+  if (finite < MIN_POINTS) {
+    throw Error(ErrorCode::EMPTY_INPUT,
+                "cloud has " + std::to_string(finite) + " finite points; at least " +
+                    std::to_string(MIN_POINTS) + " are needed to model a tree");
+  }
+  Points clean;
+  if (finite < input.size()) {
+    clean.reserve(finite);
+    for (const auto& p : input) {
+      if (p.allFinite())
+        clean.push_back(p);
+    }
+  }
+  result->points = preprocess(finite < input.size() ? clean : input, config, &result->preprocess);
+  Points().swap(clean);
+  result->notices = preprocessNotices(result->preprocess, result->points.size(), config);
+  if (result->points.size() < MIN_POINTS) {
+    throw Error(ErrorCode::EMPTY_INPUT, "only " + std::to_string(result->points.size()) +
+                                            " points left after preprocessing");
+  }
+}
+
+/// @throws Error NO_TRUNK for points that fill a volume instead of lying on surfaces
+void requireSurfaces(double dimension) {
+  if (dimension <= MAX_STRUCTURE_DIMENSION)
+    return;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "no tree found: the points fill a volume instead of lying on surfaces "
+                "(neighbour growth dimension %.2f over %.0f-%.0f cm, above %.1f; scanned trees "
+                "give 1.7-2.0, noise 3)",
+                dimension, 100 * STRUCTURE_RADIUS_M, 200 * STRUCTURE_RADIUS_M,
+                MAX_STRUCTURE_DIMENSION);
+  throw Error(ErrorCode::NO_TRUNK, text);
+}
+
+/// @throws Error NO_TRUNK for a best trunk whose returns scatter beyond MAX_NOISE_SIGMA_M
+void requireScannedSurface(double sigma) {
+  if (sigma <= MAX_NOISE_SIGMA_M)
+    return;
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "no tree found: the returns around the best trunk candidate scatter %.0f mm "
+                "(1 sigma) about its fit, over %.0f mm: no scanned surface",
+                1000 * sigma, 1000 * MAX_NOISE_SIGMA_M);
+  throw Error(ErrorCode::NO_TRUNK, text);
+}
+
+/// What Algorithm 3 models the trunk from.
+struct TrunkRegion {
+  std::vector<int> points;            ///< indices of the trunk region's points, sorted
+  std::vector<Eigen::Vector3d> axis;  ///< initial centreline, bottom to top
+  double radius = 0.0;                ///< typical trunk radius (m), 0 when unknown
+};
+
+/// Algorithm 3's trunk region: the trunk and primary-branch clusters, the trunk clusters'
+/// centroids as the axis (a lone trunk cluster's fitted axis) and their median fitted radius.
+/// @throws Error NO_TRUNK for a lone trunk cluster without a cylinder fit
+TrunkRegion pathRegion(const std::vector<Cluster>& clusters, const TrunkPath& path) {
+  TrunkRegion r;
+  for (const int c : path.trunk) {
+    r.points.insert(r.points.end(), clusters[c].members.begin(), clusters[c].members.end());
+    r.axis.push_back(clusters[c].centroid);
+  }
+  if (path.trunk.size() == 1) {
+    const auto& c = clusters[path.trunk[0]];
+    if (!c.fit)
+      throw Error(ErrorCode::NO_TRUNK, "no trunk: the lowest cluster is not cylindrical");
+    r.axis = {c.fit->center - 0.5 * c.fit->length * c.fit->axis,
+              c.fit->center + 0.5 * c.fit->length * c.fit->axis};
+  }
+  for (const int c : path.primary)
+    r.points.insert(r.points.end(), clusters[c].members.begin(), clusters[c].members.end());
+  std::sort(r.points.begin(), r.points.end());
+  std::vector<double> radii;
+  for (const int c : path.trunk) {
+    if (clusters[c].fit && clusters[c].fit->radius < MAX_TRUNK_FIT_RADIUS_M)
+      radii.push_back(clusters[c].fit->radius);
+  }
+  std::sort(radii.begin(), radii.end());
+  r.radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
+  return r;
+}
+
+/// Every point within `reach` (m) of the axis polyline, its ends extended by 5 cm: the trunk
+/// region around a tracked trunk, not only the clusters Algorithm 2 linked.
+std::vector<int> pointsNearAxis(const Points& pts, const std::vector<Eigen::Vector3d>& axis,
+                                double reach) {
+  const Centerline line(axis);
+  // A near point's closest axis point lies within 5 cm of the vertices' box (the ends extend
+  // by that much), so a point farther than reach + 5 cm from the box is not near.
+  Eigen::Vector3d lo = axis.front(), hi = axis.front();
+  for (const auto& c : axis) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  lo.array() -= reach + 0.06;
+  hi.array() += reach + 0.06;
+  std::vector<char> near(pts.size(), 0);
+  parallelFor(static_cast<int>(pts.size()), [&](int i) {
+    if ((pts[i].array() < lo.array()).any() || (pts[i].array() > hi.array()).any())
+      return;
+    double d = 0.0;
+    const double s = line.project(pts[i], &d);
+    near[i] = d <= reach && s >= -0.05 && s <= line.length() + 0.05;
+  });
+  std::vector<int> out;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (near[i])
+      out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+/// The trunk's cylinders as the model reports them, each with its inliers among the region's
+/// points in its stretch of the centreline (marked TRUNK in `classes`).
+std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<int>& region,
+                                          const TrunkModel& trunk, const ModelerConfig& config,
+                                          std::vector<PointClass>* classes) {
+  std::vector<double> region_s(region.size());
+  parallelFor(static_cast<int>(region.size()),
+              [&](int k) { region_s[k] = trunk.centerline.project(pts[region[k]]); });
+  const double band = std::max(config.cylinder_threshold, noiseBand(trunk.noise_sigma));
+  std::vector<CylinderModel> out;
+  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+    const Cylinder& c = trunk.cylinders[i];
+    std::size_t inliers = 0, total = 0;
+    for (std::size_t j = 0; j < region.size(); ++j) {
+      const double s = region_s[j];
+      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second)
+        continue;
+      ++total;
+      if (std::abs(axisDistance(c, pts[region[j]]) - c.radius) < band) {
+        ++inliers;
+        (*classes)[region[j]] = PointClass::TRUNK;
+      }
+    }
+    out.push_back(toModel(c, static_cast<int>(i), inliers, total));
+  }
+  return out;
+}
+
+/// A branch fit as the model reports it, measured where its axis meets the trunk, which may be
+/// another segment than the one its candidate points came nearest to. The trunk diameter there
+/// is interpolated: a segment's own diameter put 13-18 % of the branches on the wrong segment
+/// of a tall cluster and ignored the taper along it (3.8 mm mean error at the attachment, 6 mm
+/// noise, 36 trees; 0.8 mm interpolated).
+PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
+                            const ModelerConfig& config) {
+  PrimaryBranch pb;
+  pb.cylinder = toModel(f.cylinder, id, f.inliers.size(), f.candidates);
+  const double s = trunk.centerline.project(f.attachment);
+  pb.trunk_segment = trunk.cylinderAt(s);
+  const Cylinder& seg = trunk.cylinders[pb.trunk_segment];
+  pb.measurement.attachment_height = f.attachment.z() - trunk.baseZ();
+  pb.measurement.angle_to_trunk = std::acos(std::clamp(f.cylinder.axis.dot(seg.axis), -1.0, 1.0));
+  pb.measurement.trunk_diameter = trunk.diameterAt(s);
+  pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
+  pb.measurement.prune = pb.measurement.diameter_ratio > config.prune_ratio;
+  return pb;
+}
+
 }  // namespace
 
 ModelerConfig stageConfig(const ModelerConfig& config) {
@@ -173,32 +342,9 @@ ModelResult TreeModeler::model(const Points& input) const {
   const auto start = std::chrono::steady_clock::now();
   ModelResult result;
   Stopwatch watch(result.timings);
-  std::size_t finite = 0;
-  for (const auto& p : input)
-    finite += p.allFinite();
-  if (finite < MIN_POINTS) {
-    throw Error(ErrorCode::EMPTY_INPUT,
-                "cloud has " + std::to_string(finite) + " finite points; at least " +
-                    std::to_string(MIN_POINTS) + " are needed to model a tree");
-  }
-  // A copy only when there is something to drop: a whole scan is hundreds of MB.
-  Points clean;
-  if (finite < input.size()) {
-    clean.reserve(finite);
-    for (const auto& p : input) {
-      if (p.allFinite())
-        clean.push_back(p);
-    }
-  }
-  result.points = preprocess(finite < input.size() ? clean : input, config_, &result.preprocess);
-  Points().swap(clean);
-  result.notices = preprocessNotices(result.preprocess, result.points.size(), config_);
+  preprocessInput(input, config_, &result);
   const Points& pts = result.points;
   watch.lap("preprocess");
-  if (pts.size() < MIN_POINTS) {
-    throw Error(ErrorCode::EMPTY_INPUT,
-                "only " + std::to_string(pts.size()) + " points left after preprocessing");
-  }
 
   // One index of the modeled cloud for the spacing, the graph, the trunk tracking and the
   // branch step.
@@ -206,20 +352,10 @@ ModelResult TreeModeler::model(const Points& input) const {
   watch.lap("index");
   result.structure_dimension =
       neighbourGrowthDimension(pts, index, STRUCTURE_RADIUS_M, STRUCTURE_SAMPLES);
+  requireSurfaces(result.structure_dimension);
   watch.lap("structure");
-  if (result.structure_dimension > MAX_STRUCTURE_DIMENSION) {
-    char text[256];
-    std::snprintf(text, sizeof(text),
-                  "no tree found: the points fill a volume instead of lying on surfaces "
-                  "(neighbour growth dimension %.2f over %.0f-%.0f cm, above %.1f; scanned trees "
-                  "give 1.7-2.0, noise 3)",
-                  result.structure_dimension, 100 * STRUCTURE_RADIUS_M, 200 * STRUCTURE_RADIUS_M,
-                  MAX_STRUCTURE_DIMENSION);
-    throw Error(ErrorCode::NO_TRUNK, text);
-  }
   // Algorithm 2.
   auto clusters = initialClusters(pts, config_, medianSpacing(pts, index));
-
   watch.lap("kmeans");
   result.split_error = config_.ours_derive_parameters
                            ? derivedSplitError(clusters, config_.split_error)
@@ -234,126 +370,35 @@ ModelResult TreeModeler::model(const Points& input) const {
   result.trunk_clusters = static_cast<int>(path.trunk.size());
   result.primary_clusters = static_cast<int>(path.primary.size());
 
-  // Algorithm 3: the trunk region is the trunk and primary-branch clusters.
-  std::vector<int> region;
-  std::vector<Eigen::Vector3d> axis;
-  for (const int c : path.trunk) {
-    region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
-    axis.push_back(clusters[c].centroid);
-  }
-  if (path.trunk.size() == 1) {
-    const auto& c = clusters[path.trunk[0]];
-    if (!c.fit)
-      throw Error(ErrorCode::NO_TRUNK, "no trunk: the lowest cluster is not cylindrical");
-    axis = {c.fit->center - 0.5 * c.fit->length * c.fit->axis,
-            c.fit->center + 0.5 * c.fit->length * c.fit->axis};
-  }
-  for (const int c : path.primary)
-    region.insert(region.end(), clusters[c].members.begin(), clusters[c].members.end());
-  std::sort(region.begin(), region.end());
-  std::vector<double> radii;
-  for (const int c : path.trunk) {
-    if (clusters[c].fit && clusters[c].fit->radius < MAX_TRUNK_FIT_RADIUS_M)
-      radii.push_back(clusters[c].fit->radius);
-  }
-  std::sort(radii.begin(), radii.end());
-  double radius = radii.empty() ? 0.0 : radii[radii.size() / 2];
+  // Algorithm 3 on the trunk region: Algorithm 2's, or (ours) the points around the best
+  // tracked trunk.
+  TrunkRegion region = pathRegion(clusters, path);
   if (config_.ours_follow_diameter) {
     if (const auto tracked =
             trackBestTrunk(pts, index, clusters, path, config_, &result.trunk_candidates)) {
-      axis = tracked->centers;
-      radius = median(tracked->radii);
-      // The trunk region becomes every point near the tracked axis, not only the clusters
-      // Algorithm 2 linked.
-      const Centerline line(axis);
-      const double reach = trunkReach(radius);
-      // A near point's closest axis point lies within 5 cm of the vertices' box (the ends
-      // extend by that much), so a point farther than reach + 5 cm from the box is not near.
-      Eigen::Vector3d lo = axis.front(), hi = axis.front();
-      for (const auto& c : axis) {
-        lo = lo.cwiseMin(c);
-        hi = hi.cwiseMax(c);
-      }
-      lo.array() -= reach + 0.06;
-      hi.array() += reach + 0.06;
-      std::vector<char> near(pts.size(), 0);
-      parallelFor(static_cast<int>(pts.size()), [&](int i) {
-        if ((pts[i].array() < lo.array()).any() || (pts[i].array() > hi.array()).any())
-          return;
-        double d = 0.0;
-        const double s = line.project(pts[i], &d);
-        near[i] = d <= reach && s >= -0.05 && s <= line.length() + 0.05;
-      });
-      region.clear();
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (near[i])
-          region.push_back(static_cast<int>(i));
-      }
+      region.axis = tracked->centers;
+      region.radius = median(tracked->radii);
+      region.points = pointsNearAxis(pts, region.axis, trunkReach(region.radius));
     }
   }
   watch.lap("track");
-  const TrunkModel trunk = modelTrunk(pts, region, axis, radius, config_);
-
+  const TrunkModel trunk = modelTrunk(pts, region.points, region.axis, region.radius, config_);
   result.noise_sigma = trunk.noise_sigma;
   watch.lap("trunk");
-  if (trunk.noise_sigma > MAX_NOISE_SIGMA_M) {
-    char text[256];
-    std::snprintf(text, sizeof(text),
-                  "no tree found: the returns around the best trunk candidate scatter %.0f mm "
-                  "(1 sigma) about its fit, over %.0f mm: no scanned surface",
-                  1000 * trunk.noise_sigma, 1000 * MAX_NOISE_SIGMA_M);
-    throw Error(ErrorCode::NO_TRUNK, text);
-  }
-  const auto branches = modelBranches(pts, index, trunk, region, config_, &result.rejected_branches,
-                                      result.preprocess.wire_directions);
+  requireScannedSurface(trunk.noise_sigma);
+  const auto branches = modelBranches(pts, index, trunk, region.points, config_,
+                                      &result.rejected_branches, result.preprocess.wire_directions);
   watch.lap("branches");
 
-  // Model, measurements and point classes.
   TreeModel& model = result.model;
   model.input_points = input.size();
   result.classes.assign(pts.size(), PointClass::OTHER);
-  const double base_z = trunk.baseZ();
-  std::vector<double> region_s(region.size());
-  parallelFor(static_cast<int>(region.size()),
-              [&](int k) { region_s[k] = trunk.centerline.project(pts[region[k]]); });
-  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
-    const Cylinder& c = trunk.cylinders[i];
-    std::size_t inliers = 0, total = 0;
-    for (std::size_t j = 0; j < region.size(); ++j) {
-      const int k = region[j];
-      const double s = region_s[j];
-      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second)
-        continue;
-      ++total;
-      if (std::abs(axisDistance(c, pts[k]) - c.radius) <
-          std::max(config_.cylinder_threshold, noiseBand(trunk.noise_sigma))) {
-        ++inliers;
-        result.classes[k] = PointClass::TRUNK;
-      }
-    }
-    model.trunk.push_back(toModel(c, static_cast<int>(i), inliers, total));
-  }
+  model.trunk = trunkCylinders(pts, region.points, trunk, config_, &result.classes);
   const int first_branch_id = static_cast<int>(trunk.cylinders.size());
   for (std::size_t b = 0; b < branches.size(); ++b) {
-    const BranchFit& f = branches[b];
-    PrimaryBranch pb;
-    pb.cylinder =
-        toModel(f.cylinder, first_branch_id + static_cast<int>(b), f.inliers.size(), f.candidates);
-    // Measured where the branch's axis meets the trunk, which may be another segment than the
-    // one its candidate points came nearest to. The diameter there is interpolated: a
-    // segment's own diameter put 13-18 % of the branches on the wrong segment of a tall cluster
-    // and ignored the taper along it (3.8 mm mean error at the attachment, 6 mm noise, 36
-    // trees; 0.8 mm interpolated).
-    const double s = trunk.centerline.project(f.attachment);
-    pb.trunk_segment = trunk.cylinderAt(s);
-    const Cylinder& seg = trunk.cylinders[pb.trunk_segment];
-    pb.measurement.attachment_height = f.attachment.z() - base_z;
-    pb.measurement.angle_to_trunk = std::acos(std::clamp(f.cylinder.axis.dot(seg.axis), -1.0, 1.0));
-    pb.measurement.trunk_diameter = trunk.diameterAt(s);
-    pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
-    pb.measurement.prune = pb.measurement.diameter_ratio > config_.prune_ratio;
-    model.primary_branches.push_back(pb);
-    for (const int k : f.inliers)
+    model.primary_branches.push_back(
+        primaryBranch(branches[b], trunk, first_branch_id + static_cast<int>(b), config_));
+    for (const int k : branches[b].inliers)
       result.classes[k] = PointClass::PRIMARY;
   }
   model.correction = describeCorrection(config_, model, trunk.noise_sigma);
