@@ -174,30 +174,33 @@ void preprocessInput(const Points& input, const ModelerConfig& config, ModelResu
   }
 }
 
+/// Throws "no tree found" (Error NO_TRUNK) with a printf-formatted reason.
+template <typename... Args>
+[[noreturn]] void throwNoTree(const char* format, Args... args) {
+  char text[256];
+  std::snprintf(text, sizeof(text), format, args...);
+  throw Error(ErrorCode::NO_TRUNK, text);
+}
+
 /// @throws Error NO_TRUNK for points that fill a volume instead of lying on surfaces
 void requireSurfaces(double dimension) {
-  if (dimension <= MAX_STRUCTURE_DIMENSION)
-    return;
-  char text[256];
-  std::snprintf(text, sizeof(text),
-                "no tree found: the points fill a volume instead of lying on surfaces "
-                "(neighbour growth dimension %.2f over %.0f-%.0f cm, above %.1f; scanned trees "
-                "give 1.7-2.0, noise 3)",
-                dimension, 100 * STRUCTURE_RADIUS_M, 200 * STRUCTURE_RADIUS_M,
-                MAX_STRUCTURE_DIMENSION);
-  throw Error(ErrorCode::NO_TRUNK, text);
+  if (dimension > MAX_STRUCTURE_DIMENSION) {
+    throwNoTree(
+        "no tree found: the points fill a volume instead of lying on surfaces "
+        "(neighbour growth dimension %.2f over %.0f-%.0f cm, above %.1f; scanned trees "
+        "give 1.7-2.0, noise 3)",
+        dimension, 100 * STRUCTURE_RADIUS_M, 200 * STRUCTURE_RADIUS_M, MAX_STRUCTURE_DIMENSION);
+  }
 }
 
 /// @throws Error NO_TRUNK for a best trunk whose returns scatter beyond MAX_NOISE_SIGMA_M
 void requireScannedSurface(double sigma) {
-  if (sigma <= MAX_NOISE_SIGMA_M)
-    return;
-  char text[256];
-  std::snprintf(text, sizeof(text),
-                "no tree found: the returns around the best trunk candidate scatter %.0f mm "
-                "(1 sigma) about its fit, over %.0f mm: no scanned surface",
-                1000 * sigma, 1000 * MAX_NOISE_SIGMA_M);
-  throw Error(ErrorCode::NO_TRUNK, text);
+  if (sigma > MAX_NOISE_SIGMA_M) {
+    throwNoTree(
+        "no tree found: the returns around the best trunk candidate scatter %.0f mm "
+        "(1 sigma) about its fit, over %.0f mm: no scanned surface",
+        1000 * sigma, 1000 * MAX_NOISE_SIGMA_M);
+  }
 }
 
 /// What Algorithm 3 models the trunk from.
