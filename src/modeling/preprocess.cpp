@@ -45,7 +45,9 @@ constexpr double WIRE_MAX_GAP = 0.35;        // m: a wire's returns are never sp
 constexpr double WIRE_MAX_TILT = 15.0 * M_PI / 180.0;
 constexpr double WIRE_MAX_CROSSING = 10.0 * M_PI / 180.0;  // from the row's direction
 constexpr int MAX_WIRES = 10;
-constexpr double WIRE_TEST_VOXEL = 0.01;  // m
+constexpr int WIRE_HYPOTHESES = 300;         // lines sampled per wire searched
+constexpr std::size_t MIN_WIRE_SUPPORT = 5;  // line-like candidates on a line worth judging
+constexpr double WIRE_TEST_VOXEL = 0.01;     // m
 
 /// Downsamples pts again on coarser grids until at most `cap` are left.
 /// @param voxel the grid pts were downsampled on (m); receives the grid used
@@ -141,16 +143,13 @@ double longestRun(std::vector<double>& t) {
   return best;
 }
 
-std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
-                        std::vector<Eigen::Vector3d>* directions) {
-  if (pts.size() < 100)
-    return 0;
-  // Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
-  // is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points,
-  // against a 1 cm grid of the cloud: the shape of a 10 cm ball needs no finer sampling. The
-  // ball is gathered from the 27 cells of a 10 cm grid around the point (cheaper than a k-d
-  // tree for 20000 balls of hundreds of points each; the same ball, its edge measured in double
-  // precision where the single-precision tree rounded).
+/// Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
+/// is a ribbon a few cm wide, still much narrower than long). Checked on a sample of points,
+/// against a 1 cm grid of the cloud: the shape of a 10 cm ball needs no finer sampling. The
+/// ball is gathered from the 27 cells of a 10 cm grid around the point (cheaper than a k-d tree
+/// for 20000 balls of hundreds of points each; the same ball, its edge measured in double
+/// precision where the single-precision tree rounded).
+std::vector<int> lineLikePoints(const Points& pts) {
   const Points coarse = voxelDownsample(pts, WIRE_TEST_VOXEL);
   const detail::CellKeys grid = detail::sortedByCell(coarse, WIRE_NEIGHBOURHOOD);
   const std::size_t stride = std::max<std::size_t>(1, pts.size() / 20000);
@@ -184,62 +183,77 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     if (linear[k])
       candidates.push_back(static_cast<int>(static_cast<std::size_t>(k) * stride));
   }
-  Rng rng(seed);
-  std::vector<std::pair<Eigen::Vector3d, std::vector<int>>> found;  // direction, points
-  for (int wire = 0; wire < MAX_WIRES && candidates.size() >= 10; ++wire) {
-    const int n = static_cast<int>(candidates.size());
-    Eigen::Vector3d best_o = Eigen::Vector3d::Zero(), best_d = Eigen::Vector3d::UnitX();
-    std::size_t best_count = 0;
-    for (int it = 0; it < 300; ++it) {
-      const Eigen::Vector3d& a = pts[candidates[rng.uniformInt(0, n - 1)]];
-      const Eigen::Vector3d& b = pts[candidates[rng.uniformInt(0, n - 1)]];
-      Eigen::Vector3d d = b - a;
-      if (d.norm() < 0.3)
-        continue;
-      d.normalize();
-      if (std::abs(d.z()) > std::sin(WIRE_MAX_TILT))
-        continue;
-      std::size_t count = 0;
-      for (const int i : candidates) {
-        const Eigen::Vector3d w = pts[i] - a;
-        count += (w - w.dot(d) * d).squaredNorm() < WIRE_BAND * WIRE_BAND;
-      }
-      if (count > best_count) {
-        best_count = count;
-        best_o = a;
-        best_d = d;
-      }
-    }
-    if (best_count < 5)
-      break;
-    std::vector<double> along;
-    std::vector<int> inliers;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Eigen::Vector3d w = pts[i] - best_o;
-      if ((w - w.dot(best_d) * best_d).squaredNorm() < WIRE_BAND * WIRE_BAND) {
-        inliers.push_back(static_cast<int>(i));
-        along.push_back(w.dot(best_d));
-      }
-    }
-    // Whatever the verdict, these candidates are settled.
-    std::vector<int> rest;
-    for (const int i : candidates) {
-      const Eigen::Vector3d w = pts[i] - best_o;
-      if ((w - w.dot(best_d) * best_d).squaredNorm() >= WIRE_BAND * WIRE_BAND)
-        rest.push_back(i);
-    }
-    candidates.swap(rest);
-    if (longestRun(along) < min_length)
-      continue;
-    // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
-    Points line;
-    for (const int i : inliers)
-      line.push_back(pts[i]);
-    found.push_back({principalAxis(line), std::move(inliers)});
+  return candidates;
+}
+
+/// A line through `origin` along unit `direction`, and how many candidates lie within
+/// WIRE_BAND of it.
+struct WireLine {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  std::size_t support = 0;
+
+  bool near(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d w = p - origin;
+    return (w - w.dot(direction) * direction).squaredNorm() < WIRE_BAND * WIRE_BAND;
   }
-  // The wires of a row are parallel: the direction most of the lines found share is the row's,
-  // and a "wire" across it is a pair of opposite branches in line (thick ones return more
-  // points than a wire: the count alone does not tell).
+};
+
+/// The best-supported of WIRE_HYPOTHESES near-horizontal lines through two candidates at least
+/// 30 cm apart (support 0 when none was).
+WireLine bestLine(const Points& pts, const std::vector<int>& candidates, Rng& rng) {
+  const int n = static_cast<int>(candidates.size());
+  WireLine best;
+  for (int it = 0; it < WIRE_HYPOTHESES; ++it) {
+    const Eigen::Vector3d& a = pts[candidates[rng.uniformInt(0, n - 1)]];
+    const Eigen::Vector3d& b = pts[candidates[rng.uniformInt(0, n - 1)]];
+    const Eigen::Vector3d d = b - a;
+    if (d.norm() < 0.3 || std::abs(d.normalized().z()) > std::sin(WIRE_MAX_TILT))
+      continue;
+    WireLine line{a, d.normalized()};
+    for (const int i : candidates)
+      line.support += line.near(pts[i]);
+    if (line.support > best.support)
+      best = line;
+  }
+  return best;
+}
+
+/// The points near a line (indices), and the length of their longest run along it without a
+/// gap over WIRE_MAX_GAP.
+std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run) {
+  std::vector<double> along;
+  std::vector<int> inliers;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (line.near(pts[i])) {
+      inliers.push_back(static_cast<int>(i));
+      along.push_back((pts[i] - line.origin).dot(line.direction));
+    }
+  }
+  *run = longestRun(along);
+  return inliers;
+}
+
+/// Keeps the candidates off the line: whatever the verdict, those on it are settled.
+void settle(std::vector<int>& candidates, const Points& pts, const WireLine& line) {
+  std::vector<int> rest;
+  for (const int i : candidates) {
+    if (!line.near(pts[i]))
+      rest.push_back(i);
+  }
+  candidates.swap(rest);
+}
+
+/// A wire found: its direction and its points (indices).
+struct FoundWire {
+  Eigen::Vector3d direction;
+  std::vector<int> points;
+};
+
+/// The wires of a row are parallel: the direction most of the lines found share is the row's,
+/// and a "wire" across it is a pair of opposite branches in line (thick ones return more points
+/// than a wire: the count alone does not tell). Returns the lines found along the row.
+std::vector<FoundWire> alongTheRow(std::vector<FoundWire> found) {
   const auto parallel = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return std::abs(a.dot(b)) >= std::cos(WIRE_MAX_CROSSING);
   };
@@ -247,20 +261,48 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
   for (std::size_t k = 0; k < found.size(); ++k) {
     std::size_t votes = 0;
     for (const auto& other : found)
-      votes += parallel(found[k].first, other.first);
+      votes += parallel(found[k].direction, other.direction);
     if (votes > best_votes ||
-        (votes == best_votes && found[k].second.size() > found[strongest].second.size())) {
+        (votes == best_votes && found[k].points.size() > found[strongest].points.size())) {
       best_votes = votes;
       strongest = k;
     }
   }
+  std::vector<FoundWire> out;
+  for (auto& f : found) {
+    if (parallel(f.direction, found[strongest].direction))
+      out.push_back(std::move(f));
+  }
+  return out;
+}
+
+std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
+                        std::vector<Eigen::Vector3d>* directions) {
+  if (pts.size() < 100)
+    return 0;
+  std::vector<int> candidates = lineLikePoints(pts);
+  Rng rng(seed);
+  std::vector<FoundWire> found;
+  for (int wire = 0; wire < MAX_WIRES && candidates.size() >= 10; ++wire) {
+    const WireLine line = bestLine(pts, candidates, rng);
+    if (line.support < MIN_WIRE_SUPPORT)
+      break;
+    double run = 0.0;
+    std::vector<int> inliers = lineRun(pts, line, &run);
+    settle(candidates, pts, line);
+    if (run < min_length)
+      continue;
+    // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
+    Points points;
+    for (const int i : inliers)
+      points.push_back(pts[i]);
+    found.push_back({principalAxis(points), std::move(inliers)});
+  }
   std::size_t removed = 0;
   std::vector<char> drop(pts.size(), 0);
-  for (const auto& [dir, inliers] : found) {
-    if (!parallel(dir, found[strongest].first))
-      continue;
-    directions->push_back(dir);
-    for (const int i : inliers) {
+  for (const auto& wire : alongTheRow(std::move(found))) {
+    directions->push_back(wire.direction);
+    for (const int i : wire.points) {
       removed += !drop[i];
       drop[i] = 1;
     }
