@@ -533,6 +533,100 @@ void splitAtBends(const Centerline& line, double a, double b, double step, doubl
   splitAtBends(line, at, b, step, max_bend, min_length, cuts);
 }
 
+/// Cuts with the segments shorter than min_length (m) joined to their upper neighbour (the
+/// last to its lower one): a cylinder needs some length to be measured.
+std::vector<double> joinShortSegments(const std::vector<double>& cuts, double min_length) {
+  std::vector<double> merged{cuts.front()};
+  for (std::size_t i = 1; i < cuts.size(); ++i) {
+    if (cuts[i] - merged.back() >= min_length || i + 1 == cuts.size())
+      merged.push_back(cuts[i]);
+  }
+  if (merged.size() >= 3 && merged.back() - merged[merged.size() - 2] < min_length)
+    merged.erase(merged.end() - 2);
+  return merged;
+}
+
+/// Where the share of the segment [a, b)'s points on its cylinder jumps most between bins of
+/// about a slice, if by more than curvature_jump and with min_segment_length on either side.
+std::optional<double> curvatureCut(const Points& pts, const std::vector<int>& region,
+                                   const std::vector<double>& s, const std::vector<double>& dist,
+                                   const SliceBounds& bounds, const Cylinder& cyl, double a,
+                                   double b, double cylinder_threshold,
+                                   const ModelerConfig& config) {
+  const int bins = std::max(2, static_cast<int>((b - a) / config.slice_height));
+  std::vector<int> in(bins, 0), all(bins, 0);
+  for (std::size_t k = 0; k < region.size(); ++k) {
+    if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance)
+      continue;
+    const int bin = std::min(bins - 1, static_cast<int>((s[k] - a) / (b - a) * bins));
+    ++all[bin];
+    in[bin] += std::abs(axisDistance(cyl, pts[region[k]]) - cyl.radius) < cylinder_threshold;
+  }
+  double jump = 0.0;
+  int at = -1;
+  for (int k = 1; k < bins; ++k) {
+    if (all[k] < MIN_SLICE_POINTS || all[k - 1] < MIN_SLICE_POINTS)
+      continue;
+    const double j =
+        std::abs(static_cast<double>(in[k]) / all[k] - static_cast<double>(in[k - 1]) / all[k - 1]);
+    const double cut = a + (b - a) * k / bins;
+    if (j > jump && cut - a >= config.min_segment_length && b - cut >= config.min_segment_length) {
+      jump = j;
+      at = k;
+    }
+  }
+  if (at > 0 && jump > config.curvature_jump)
+    return a + (b - a) * at / bins;
+  return std::nullopt;
+}
+
+/// Curvature: a segment (at least twice min_segment_length) whose outliers jump along its
+/// cylinder is split at the jump.
+std::vector<double> splitAtCurvature(const Points& pts, const std::vector<int>& region,
+                                     const std::vector<double>& s, const std::vector<double>& dist,
+                                     const SliceBounds& bounds, const Centerline& line,
+                                     const std::vector<Slice>& slices,
+                                     const std::vector<double>& cuts, double cylinder_threshold,
+                                     double scatter, const ModelerConfig& config) {
+  std::vector<double> out{cuts.front()};
+  std::uint64_t stream = 0;
+  for (std::size_t i = 1; i < cuts.size(); ++i) {
+    const double a = out.back(), b = cuts[i];
+    if (b - a >= 2.0 * config.min_segment_length) {
+      if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices,
+                                      cylinder_threshold, scatter, config, stream++)) {
+        if (const auto cut =
+                curvatureCut(pts, region, s, dist, bounds, *cyl, a, b, cylinder_threshold, config))
+          out.push_back(*cut);
+      }
+    }
+    out.push_back(b);
+  }
+  return out;
+}
+
+/// Each segment longer than max_length (m) cut into equal parts no longer than it.
+std::vector<double> splitLongSegments(const std::vector<double>& cuts, double max_length) {
+  std::vector<double> out{cuts.front()};
+  for (std::size_t i = 1; i < cuts.size(); ++i) {
+    const double a = out.back(), b = cuts[i];
+    const int parts = static_cast<int>(std::ceil((b - a) / max_length - 1e-9));
+    for (int k = 1; k < parts; ++k)
+      out.push_back(a + (b - a) * k / parts);
+    out.push_back(b);
+  }
+  return out;
+}
+
+/// A trunk tapers: a segment measured thicker than the one below it by more than a swelling at
+/// a whorl (TAPER_SWELL) has circles through branch bases or noise wider than its radius (the
+/// thin top at high noise); the segment below bounds it.
+void boundByTheSegmentBelow(std::vector<Cylinder>& cylinders) {
+  for (std::size_t i = 1; i < cylinders.size(); ++i)
+    cylinders[i].radius =
+        std::min(cylinders[i].radius, cylinders[i - 1].radius * (1.0 + TAPER_SWELL));
+}
+
 }  // namespace
 
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
@@ -599,55 +693,11 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     if (sl.points >= MIN_SLICE_POINTS)
       top = std::max(top, sl.s0 + h);
   }
-  auto cuts = disturbancePartitions(slices, h, config.disturbance_zero_run, top);
-  // Short segments join their upper neighbour: a cylinder needs some length to be measured.
-  std::vector<double> merged{cuts.front()};
-  for (std::size_t i = 1; i < cuts.size(); ++i) {
-    if (cuts[i] - merged.back() >= config.min_segment_length || i + 1 == cuts.size())
-      merged.push_back(cuts[i]);
-  }
-  if (merged.size() >= 3 && merged.back() - merged[merged.size() - 2] < config.min_segment_length) {
-    merged.erase(merged.end() - 2);
-  }
-  trunk.partitions = merged;
-  // Curvature: a segment whose outliers jump along its cylinder is split at the jump.
-  std::vector<double> final_cuts{merged.front()};
-  std::uint64_t stream = 0;
-  for (std::size_t i = 1; i < merged.size(); ++i) {
-    const double a = final_cuts.back(), b = merged[i];
-    if (b - a >= 2.0 * config.min_segment_length) {
-      if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices,
-                                      cylinder_threshold, scatter, config, stream++)) {
-        const int bins = std::max(2, static_cast<int>((b - a) / h));
-        std::vector<int> in(bins, 0), all(bins, 0);
-        for (std::size_t k = 0; k < region.size(); ++k) {
-          if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance)
-            continue;
-          const int bin = std::min(bins - 1, static_cast<int>((s[k] - a) / (b - a) * bins));
-          ++all[bin];
-          in[bin] +=
-              std::abs(axisDistance(*cyl, pts[region[k]]) - cyl->radius) < cylinder_threshold;
-        }
-        double jump = 0.0;
-        int at = -1;
-        for (int k = 1; k < bins; ++k) {
-          if (all[k] < MIN_SLICE_POINTS || all[k - 1] < MIN_SLICE_POINTS)
-            continue;
-          const double j = std::abs(static_cast<double>(in[k]) / all[k] -
-                                    static_cast<double>(in[k - 1]) / all[k - 1]);
-          const double cut = a + (b - a) * k / bins;
-          if (j > jump && cut - a >= config.min_segment_length &&
-              b - cut >= config.min_segment_length) {
-            jump = j;
-            at = k;
-          }
-        }
-        if (at > 0 && jump > config.curvature_jump)
-          final_cuts.push_back(a + (b - a) * at / bins);
-      }
-    }
-    final_cuts.push_back(b);
-  }
+  const auto cuts = disturbancePartitions(slices, h, config.disturbance_zero_run, top);
+  trunk.partitions = joinShortSegments(cuts, config.min_segment_length);
+  std::vector<double> final_cuts =
+      splitAtCurvature(pts, region, s, dist, bounds, line, slices, trunk.partitions,
+                       cylinder_threshold, scatter, config);
   if (config.trunk_max_bend > 0.0) {
     std::vector<double> straight{final_cuts.front()};
     for (std::size_t i = 1; i < final_cuts.size(); ++i) {
@@ -657,18 +707,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     }
     final_cuts = std::move(straight);
   }
-  if (config.trunk_max_segment_length > 0.0) {
-    std::vector<double> short_cuts{final_cuts.front()};
-    for (std::size_t i = 1; i < final_cuts.size(); ++i) {
-      const double a = short_cuts.back(), b = final_cuts[i];
-      const int parts =
-          static_cast<int>(std::ceil((b - a) / config.trunk_max_segment_length - 1e-9));
-      for (int k = 1; k < parts; ++k)
-        short_cuts.push_back(a + (b - a) * k / parts);
-      short_cuts.push_back(b);
-    }
-    final_cuts = std::move(short_cuts);
-  }
+  if (config.trunk_max_segment_length > 0.0)
+    final_cuts = splitLongSegments(final_cuts, config.trunk_max_segment_length);
   trunk.partitions = final_cuts;
   for (std::size_t i = 0; i + 1 < final_cuts.size(); ++i) {
     const double a = final_cuts[i], b = final_cuts[i + 1];
@@ -697,15 +737,8 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
       }
     }
   }
-  if (config.ours_constrain_ransac) {
-    // A trunk tapers: a segment measured thicker than the one below it by more than a swelling
-    // at a whorl has circles through branch bases or noise wider than its radius (the thin
-    // top at high noise); the segment below bounds it.
-    for (std::size_t i = 1; i < trunk.cylinders.size(); ++i) {
-      const double below = trunk.cylinders[i - 1].radius;
-      trunk.cylinders[i].radius = std::min(trunk.cylinders[i].radius, below * (1.0 + TAPER_SWELL));
-    }
-  }
+  if (config.ours_constrain_ransac)
+    boundByTheSegmentBelow(trunk.cylinders);
   return trunk;
 }
 
