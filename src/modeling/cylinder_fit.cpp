@@ -253,28 +253,35 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 namespace dormant_tree_modeling {
 namespace modeling {
 
-std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
-                                        double sigma, double scatter, double max_radius,
-                                        std::uint64_t seed, std::vector<int>* inliers) {
-  constexpr double MIN_RADIUS = 0.002;
+namespace {
+
+constexpr int MIN_THIN_POINTS = 6;
+constexpr double MIN_THIN_RADIUS_M = 0.002;
+// Robust re-centring works on slices of this length (m) along the axis.
+constexpr double THIN_SLICE_M = 0.04;
+
+/// The points within `band` of the line through o along d.
+std::vector<int> nearLine(const Points& pts, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                          double band) {
+  std::vector<int> out;
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+    const Eigen::Vector3d w = pts[i] - o;
+    if ((w - w.dot(d) * d).squaredNorm() < band * band)
+      out.push_back(i);
+  }
+  return out;
+}
+
+/// A line within 60 degrees of the guess holding the most points within `band` (100 RANSAC
+/// samples, then two least-squares refits on its points); its points, and origin and direction
+/// (towards the guess) in *cyl.
+std::vector<int> thinAxis(const Points& pts, const Eigen::Vector3d& axis_guess, double band,
+                          std::uint64_t seed, Cylinder* cyl) {
   const int n = static_cast<int>(pts.size());
-  if (n < 6)
-    return std::nullopt;
-  const double band = max_radius + std::max(noiseBand(sigma), 0.004);
-  auto lineInliers = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d,
-                         std::vector<int>& out) {
-    out.clear();
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d w = pts[i] - o;
-      if ((w - w.dot(d) * d).squaredNorm() < band * band)
-        out.push_back(i);
-    }
-  };
   Rng rng(seed);
   Eigen::Vector3d origin = Eigen::Vector3d::Zero(), dir = axis_guess.normalized();
   principalAxis(pts, &origin);
-  std::vector<int> best, in;
-  lineInliers(origin, dir, best);
+  std::vector<int> best = nearLine(pts, origin, dir, band);
   for (int it = 0; it < 100; ++it) {
     const Eigen::Vector3d& a = pts[rng.uniformInt(0, n - 1)];
     const Eigen::Vector3d& b = pts[rng.uniformInt(0, n - 1)];
@@ -284,120 +291,151 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     d.normalize();
     if (std::abs(d.dot(axis_guess.normalized())) < std::cos(M_PI / 3.0))
       continue;
-    lineInliers(a, d, in);
+    std::vector<int> in = nearLine(pts, a, d, band);
     if (in.size() > best.size()) {
-      best = in;
+      best = std::move(in);
       origin = a;
       dir = d;
     }
   }
-  for (int round = 0; round < 2 && best.size() >= 6; ++round) {
+  for (int round = 0; round < 2 && best.size() >= MIN_THIN_POINTS; ++round) {
     Points sub;
     for (const int i : best)
       sub.push_back(pts[i]);
     const Eigen::Vector3d d = principalAxis(sub, &origin);
     dir = d.dot(axis_guess) < 0.0 ? Eigen::Vector3d(-d) : d;
-    lineInliers(origin, dir, best);
+    best = nearLine(pts, origin, dir, band);
   }
-  if (best.size() < 6)
+  cyl->center = origin;
+  cyl->axis = dir;
+  return best;
+}
+
+long thinSlice(const Cylinder& cyl, const Eigen::Vector3d& p) {
+  return static_cast<long>(std::floor((p - cyl.center).dot(cyl.axis) / THIN_SLICE_M));
+}
+
+/// The points of `best` within `reach` of the axis (empty below MIN_THIN_POINTS), and the axis
+/// moved onto the line through their slices' centroids (a full cross-section's centroid is its
+/// centre) when that stays within 30 degrees.
+std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
+                          const Eigen::Vector3d& axis_guess, double reach, Cylinder* cyl) {
+  std::vector<int> used;
+  std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
+  for (const int i : best) {
+    if (axisDistance(*cyl, pts[i]) >= reach)
+      continue;
+    used.push_back(i);
+    auto it = centroids.try_emplace(thinSlice(*cyl, pts[i]), Eigen::Vector3d::Zero(), 0).first;
+    it->second.first += pts[i];
+    ++it->second.second;
+  }
+  if (used.size() < MIN_THIN_POINTS)
+    return {};
+  Points centres;
+  for (const auto& kv : centroids) {
+    if (kv.second.second >= 3)
+      centres.push_back(kv.second.first / kv.second.second);
+  }
+  if (centres.size() >= 2) {
+    Eigen::Vector3d c;
+    Eigen::Vector3d d = principalAxis(centres, &c);
+    if (d.dot(axis_guess) < 0.0)
+      d = -d;
+    if (d.dot(cyl->axis) > std::cos(30.0 * M_PI / 180.0)) {
+      cyl->center = c;
+      cyl->axis = d;
+    }
+  }
+  return used;
+}
+
+/// The median over slices (of at least MIN_THIN_POINTS) of the mean squared distance from the
+/// axis within `reach`, or of all points when no slice has enough; nullopt with fewer than
+/// MIN_THIN_POINTS. Without a scatter to remove (a raw moment, for a calibration) each slice's
+/// farthest fifth is left out: spurs and shoots on the branch. The calibration absorbs what the
+/// trimming takes from the scatter.
+std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& used,
+                                  const Cylinder& cyl, double reach, double scatter) {
+  std::map<long, std::vector<double>> sq_by_slice;
+  for (const int i : used) {
+    const double dist = axisDistance(cyl, pts[i]);
+    if (dist < reach)
+      sq_by_slice[thinSlice(cyl, pts[i])].push_back(dist * dist);
+  }
+  std::vector<double> moments;
+  double total = 0.0;
+  int total_n = 0;
+  for (auto& kv : sq_by_slice) {
+    auto& v = kv.second;
+    std::size_t keep = v.size();
+    if (scatter <= 0.0 && v.size() >= 5) {
+      keep = (v.size() * 4 + 4) / 5;
+      std::nth_element(v.begin(), v.begin() + (keep - 1), v.end());
+    }
+    double sum = 0.0;
+    for (std::size_t k = 0; k < keep; ++k)
+      sum += v[k];
+    total += sum;
+    total_n += static_cast<int>(keep);
+    if (static_cast<int>(keep) >= MIN_THIN_POINTS)
+      moments.push_back(sum / keep);
+  }
+  if (total_n < MIN_THIN_POINTS)
     return std::nullopt;
+  return moments.empty() ? total / total_n : median(std::move(moments));
+}
+
+/// Centre and length from the used points' extent along the axis, and their mean |d - r|.
+void finishThinCylinder(const Points& pts, const std::vector<int>& used, Cylinder* cyl) {
+  double lo = 1e300, hi = -1e300, abs_err = 0.0;
+  for (const int i : used) {
+    const double t = (pts[i] - cyl->center).dot(cyl->axis);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+    abs_err += std::abs(axisDistance(*cyl, pts[i]) - cyl->radius);
+  }
+  cyl->center += 0.5 * (lo + hi) * cyl->axis;
+  cyl->length = hi - lo;
+  cyl->mean_abs_error = abs_err / static_cast<int>(used.size());
+}
+
+}  // namespace
+
+std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
+                                        double sigma, double scatter, double max_radius,
+                                        std::uint64_t seed, std::vector<int>* inliers) {
+  if (pts.size() < MIN_THIN_POINTS)
+    return std::nullopt;
+  const double band = max_radius + std::max(noiseBand(sigma), 0.004);
   Cylinder cyl;
-  cyl.center = origin;
-  cyl.axis = dir;
-  // Robust re-centring: per 4 cm slice along the axis, the centroid of the points within
-  // radius + 2.5 sigma of the current axis (a full cross-section's centroid is its centre);
-  // a line through the slice centroids; the radius from the median of the slices' second
-  // moments less the noise. A parallel shoot or a spur moves a least-squares cylinder, not this.
-  constexpr double SLICE = 0.04;
+  const std::vector<int> best = thinAxis(pts, axis_guess, band, seed, &cyl);
+  if (best.size() < MIN_THIN_POINTS)
+    return std::nullopt;
+  // Robust re-centring: per slice the centroid of the points within radius + 2.5 sigma of the
+  // current axis, a line through the slice centroids, the radius from the median of the
+  // slices' second moments less the noise. A parallel shoot or a spur moves a least-squares
+  // cylinder, not this.
   std::vector<int> used;
   double radius = max_radius;
   for (int round = 0; round < 5; ++round) {
     // The moment must see the whole scatter it then subtracts.
     const double reach = radius + noiseBand(std::max(sigma, scatter)) + 0.002;
-
-    used.clear();
-    std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
-    for (const int i : best) {
-      if (axisDistance(cyl, pts[i]) >= reach)
-        continue;
-      used.push_back(i);
-      const long key = static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE));
-      auto it = centroids.try_emplace(key, Eigen::Vector3d::Zero(), 0).first;
-      it->second.first += pts[i];
-      ++it->second.second;
-    }
-    if (used.size() < 6)
+    used = recentre(pts, best, axis_guess, reach, &cyl);
+    if (used.empty())
       return std::nullopt;
-    Points centres;
-    for (const auto& kv : centroids) {
-      if (kv.second.second >= 3)
-        centres.push_back(kv.second.first / kv.second.second);
-    }
-    if (centres.size() >= 2) {
-      Eigen::Vector3d c;
-      Eigen::Vector3d d = principalAxis(centres, &c);
-      if (d.dot(axis_guess) < 0.0)
-        d = -d;
-      if (d.dot(cyl.axis) > std::cos(30.0 * M_PI / 180.0)) {
-        cyl.center = c;
-        cyl.axis = d;
-      }
-    }
-    std::map<long, std::vector<double>> sq_by_slice;
-    for (const int i : used) {
-      const double dist = axisDistance(cyl, pts[i]);
-      if (dist < reach)
-        sq_by_slice[static_cast<long>(std::floor((pts[i] - cyl.center).dot(cyl.axis) / SLICE))]
-            .push_back(dist * dist);
-    }
-    // The raw moment (for a calibration) leaves out each slice's farthest fifth: spurs and
-    // shoots on the branch. The calibration absorbs what the trimming takes from the scatter.
-    std::map<long, std::pair<double, int>> moments_by_slice;
-    for (auto& kv : sq_by_slice) {
-      auto& v = kv.second;
-      std::size_t keep = v.size();
-      if (scatter <= 0.0 && v.size() >= 5) {
-        keep = (v.size() * 4 + 4) / 5;
-        std::nth_element(v.begin(), v.begin() + (keep - 1), v.end());
-      }
-      auto& m = moments_by_slice[kv.first];
-      for (std::size_t k = 0; k < keep; ++k)
-        m.first += v[k];
-      m.second = static_cast<int>(keep);
-    }
-    std::vector<double> moments;
-    double total = 0.0;
-    int total_n = 0;
-    for (const auto& kv : moments_by_slice) {
-      total += kv.second.first;
-      total_n += kv.second.second;
-      if (kv.second.second >= 6)
-        moments.push_back(kv.second.first / kv.second.second);
-    }
-    if (total_n < 6)
+    const auto moment = sliceMoment(pts, used, cyl, reach, scatter);
+    if (!moment)
       return std::nullopt;
-    double moment = total / total_n;
-    if (!moments.empty())
-      moment = median(std::move(moments));
     // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
     // it may exceed the radius bound by the scatter it carries.
     const double upper =
         scatter > 0.0 ? max_radius : max_radius + noiseBand(std::max(sigma, 0.004)) + 0.002;
-    radius = std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_RADIUS, upper);
+    radius =
+        std::clamp(std::sqrt(std::max(0.0, *moment - scatter * scatter)), MIN_THIN_RADIUS_M, upper);
   }
   cyl.radius = radius;
-  const int count = static_cast<int>(used.size());
-  // Extent and error statistics over the points used.
-  double lo = 1e300, hi = -1e300, abs_err = 0.0;
-  for (const int i : used) {
-    const double t = (pts[i] - cyl.center).dot(cyl.axis);
-    lo = std::min(lo, t);
-    hi = std::max(hi, t);
-    abs_err += std::abs(axisDistance(cyl, pts[i]) - cyl.radius);
-  }
-  cyl.center += 0.5 * (lo + hi) * cyl.axis;
-  cyl.length = hi - lo;
-  cyl.mean_abs_error = abs_err / count;
+  finishThinCylinder(pts, used, &cyl);
   if (inliers)
     *inliers = used;
   return cyl;
