@@ -248,6 +248,12 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const PointInde
   return adjacency;
 }
 
+bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& config) {
+  return cluster.centroid.z() <= zmin + TRUNK_BASE_BAND_M &&
+         static_cast<int>(cluster.members.size()) >= 2 * config.min_cluster_points && cluster.fit &&
+         std::abs(cluster.fit->axis.z()) >= std::cos(config.trunk_max_tilt * DEG);
+}
+
 TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
                         const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config) {
@@ -321,13 +327,8 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
   TrunkPath best_path = walk(lowest);
   std::size_t best_size = best_path.trunk.size() + best_path.primary.size();
   for (int c = 0; c < n; ++c) {
-    const auto& fit = clusters[c].fit;
-    if (c == lowest || clusters[c].centroid.z() > zmin + TRUNK_BASE_BAND_M ||
-        adjacency[c].empty() ||
-        static_cast<int>(clusters[c].members.size()) < 2 * config.min_cluster_points || !fit ||
-        std::abs(fit->axis.z()) < std::cos(config.trunk_max_tilt * DEG)) {
+    if (c == lowest || adjacency[c].empty() || !isTrunkBase(clusters[c], zmin, config))
       continue;
-    }
     TrunkPath path = walk(c);
     const std::size_t size = path.trunk.size() + path.primary.size();
     if (size > best_size) {

@@ -260,16 +260,16 @@ constexpr double MIN_THIN_RADIUS_M = 0.002;
 // Robust re-centring works on slices of this length (m) along the axis.
 constexpr double THIN_SLICE_M = 0.04;
 
-/// The points within `band` of the line through o along d.
-std::vector<int> nearLine(const Points& pts, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
-                          double band) {
-  std::vector<int> out;
+/// The points within `band` of the line through o along d, into *out (its storage reused:
+/// RANSAC calls this a hundred times a fit).
+void nearLine(const Points& pts, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double band,
+              std::vector<int>* out) {
+  out->clear();
   for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
     const Eigen::Vector3d w = pts[i] - o;
     if ((w - w.dot(d) * d).squaredNorm() < band * band)
-      out.push_back(i);
+      out->push_back(i);
   }
-  return out;
 }
 
 /// A line within 60 degrees of the guess holding the most points within `band` (100 RANSAC
@@ -281,7 +281,8 @@ std::vector<int> thinAxis(const Points& pts, const Eigen::Vector3d& axis_guess, 
   Rng rng(seed);
   Eigen::Vector3d origin = Eigen::Vector3d::Zero(), dir = axis_guess.normalized();
   principalAxis(pts, &origin);
-  std::vector<int> best = nearLine(pts, origin, dir, band);
+  std::vector<int> best, in;
+  nearLine(pts, origin, dir, band, &best);
   for (int it = 0; it < 100; ++it) {
     const Eigen::Vector3d& a = pts[rng.uniformInt(0, n - 1)];
     const Eigen::Vector3d& b = pts[rng.uniformInt(0, n - 1)];
@@ -291,9 +292,9 @@ std::vector<int> thinAxis(const Points& pts, const Eigen::Vector3d& axis_guess, 
     d.normalize();
     if (std::abs(d.dot(axis_guess.normalized())) < std::cos(M_PI / 3.0))
       continue;
-    std::vector<int> in = nearLine(pts, a, d, band);
+    nearLine(pts, a, d, band, &in);
     if (in.size() > best.size()) {
-      best = std::move(in);
+      best.swap(in);
       origin = a;
       dir = d;
     }
@@ -304,7 +305,7 @@ std::vector<int> thinAxis(const Points& pts, const Eigen::Vector3d& axis_guess, 
       sub.push_back(pts[i]);
     const Eigen::Vector3d d = principalAxis(sub, &origin);
     dir = d.dot(axis_guess) < 0.0 ? Eigen::Vector3d(-d) : d;
-    best = nearLine(pts, origin, dir, band);
+    nearLine(pts, origin, dir, band, &best);
   }
   cyl->center = origin;
   cyl->axis = dir;

@@ -80,6 +80,8 @@ class KMeansRun {
   std::vector<std::vector<double>> block_reach_of_;
   std::vector<std::vector<Eigen::Vector3d>> block_sums_;
   std::vector<std::vector<int>> block_counts_;
+  std::vector<Eigen::Vector3d> sums_;
+  std::vector<int> counts_;
 };
 
 void KMeansRun::blockBoxes() {
@@ -276,21 +278,19 @@ double KMeansRun::updateMeans() {
       ++count[labels_[i]];
     }
   });
-  std::vector<Eigen::Vector3d> sums(k_);
-  std::vector<int> counts(k_);
   parallelFor(k_, [&](int c) {
-    sums[c].setZero();
-    counts[c] = 0;
+    sums_[c].setZero();
+    counts_[c] = 0;
     for (int b = 0; b < blocks_; ++b) {
-      sums[c] += block_sums_[b][c];
-      counts[c] += block_counts_[b][c];
+      sums_[c] += block_sums_[b][c];
+      counts_[c] += block_counts_[b][c];
     }
   });
   double max_shift = 0.0;
   for (int c = 0; c < k_; ++c) {
     shift_[c] = 0.0;
-    if (counts[c] > 0) {
-      const Eigen::Vector3d next = sums[c] / counts[c];
+    if (counts_[c] > 0) {
+      const Eigen::Vector3d next = sums_[c] / counts_[c];
       shift_[c] = (next - centres_[c]).norm();
       centres_[c] = next;
     }
@@ -302,6 +302,8 @@ double KMeansRun::updateMeans() {
 void KMeansRun::iterate(int max_iterations) {
   block_sums_.assign(blocks_, std::vector<Eigen::Vector3d>(k_));
   block_counts_.assign(blocks_, std::vector<int>(k_));
+  sums_.assign(k_, Eigen::Vector3d::Zero());
+  counts_.assign(k_, 0);
   moved_.assign(n_, 0);
   upper_.assign(n_, INF);
   lower_.assign(n_, 0.0);

@@ -317,11 +317,8 @@ std::vector<TrunkStart> clusterTrunkStarts(const std::vector<Cluster>& clusters,
                                            const ModelerConfig& config) {
   std::vector<int> picked{path.trunk.front()};
   for (int c = 0; c < static_cast<int>(clusters.size()); ++c) {
-    const auto& fit = clusters[c].fit;
-    if (c != path.trunk.front() && clusters[c].centroid.z() <= zmin + TRUNK_BASE_BAND_M && fit &&
-        fit->radius < MAX_TRUNK_FIT_RADIUS_M &&
-        static_cast<int>(clusters[c].members.size()) >= 2 * config.min_cluster_points &&
-        std::abs(fit->axis.z()) >= std::cos(config.trunk_max_tilt * M_PI / 180.0))
+    if (c != path.trunk.front() && isTrunkBase(clusters[c], zmin, config) &&
+        clusters[c].fit->radius < MAX_TRUNK_FIT_RADIUS_M)
       picked.push_back(c);
   }
   std::vector<TrunkStart> out;

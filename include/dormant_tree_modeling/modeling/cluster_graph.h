@@ -10,7 +10,6 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
-/// @brief A cluster of points (indices into the modeled cloud) and its cylinder fit.
 /// @brief Clusters whose centroid lies at most this far (m) above the lowest cluster's are where
 /// a trunk may start: Algorithm 2's start candidates and the trunk tracking's bases.
 constexpr double TRUNK_BASE_BAND_M = 0.3;
@@ -19,12 +18,18 @@ constexpr double TRUNK_BASE_BAND_M = 0.3;
 /// patch of ground, a wall or an arc of clutter.
 constexpr double MAX_TRUNK_FIT_RADIUS_M = 0.3;
 
+/// @brief A cluster of points (indices into the modeled cloud) and its cylinder fit.
 struct Cluster {
   std::vector<int> members;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   std::optional<Cylinder> fit;  ///< least-squares cylinder; empty when the fit failed
   double error = 0.0;           ///< mean |d - r| of the fit (infinite without a fit)
 };
+
+/// @brief Whether a cluster may be a trunk's foot: its centroid at most TRUNK_BASE_BAND_M above
+/// `zmin` (the lowest cluster's), at least 2 x min_cluster_points, and a cylinder fit within
+/// trunk_max_tilt of vertical. Algorithm 2's start candidates and the trunk tracking's bases.
+bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& config);
 
 /// @brief Recompute centroid, cylinder fit and error of a cluster.
 void updateCluster(const Points& pts, Cluster& cluster);
