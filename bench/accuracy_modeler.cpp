@@ -15,9 +15,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "dormant_tree_modeling/calibration/rig_calibration.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
-#include "dormant_tree_modeling/evaluation/rig_calibration.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
@@ -112,12 +112,12 @@ modeling::SensorCalibration rigCalibration(const std::string& world, double nois
   char name[128];
   std::snprintf(name, sizeof(name), "%s/%s/rig_%gmm", out.c_str(), world.c_str(), noise_mm);
   ensureDataset(simulation::CALIBRATION_RIG_PRESET, RIG_SEED, world, noise_mm, name);
-  evaluation::RigScan scan;
+  calibration::RigScan scan;
   scan.name = name;
   scan.points = io::readPointsInFileFrame(std::string(name) + "/target.pcd");
   scan.rig = io::readTruthFile(std::string(name) + "/truth.json");
   const auto result =
-      evaluation::calibrateFromRig({scan}, modeling::ModelerConfig{}, world + "_rig");
+      calibration::calibrateFromRig({scan}, modeling::ModelerConfig{}, world + "_rig");
   for (const auto& w : result.warnings)
     std::cerr << "rig " << name << ": " << w << "\n";
   return result.calibration;

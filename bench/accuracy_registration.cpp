@@ -20,9 +20,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "dormant_tree_modeling/calibration/rig_calibration.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
-#include "dormant_tree_modeling/evaluation/rig_calibration.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
@@ -127,8 +127,8 @@ modeling::SensorCalibration rigCalibration(const std::string& world, const std::
     simulation::writeDataset(o, dir);
   }
   const auto rig = io::readTruthFile(dir + "/truth.json");
-  const auto result = evaluation::calibrateFromRig({evaluation::readRigViews(dir, rig)},
-                                                   modeling::ModelerConfig{}, world + "_rig");
+  const auto result = calibration::calibrateFromRig({calibration::readRigViews(dir, rig)},
+                                                    modeling::ModelerConfig{}, world + "_rig");
   for (const auto& w : result.warnings)
     std::cerr << dir << ": " << w << "\n";
   return result.calibration;

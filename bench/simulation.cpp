@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
@@ -82,8 +82,7 @@ void BM_SimulateFullView(benchmark::State& state) {
   config.scan_frequency_hz = static_cast<double>(state.range(0));
   const Lms111Model model(caster, config);
   const acquisition::ViewPlanConfig sweep;
-  const auto stage =
-      acquisition::stagePose(acquisition::platformPose(0, -1.5, 1.5, M_PI / 2), {}, 0.0);
+  const auto stage = geometry::stagePose(geometry::platformPose(0, -1.5, 1.5, M_PI / 2), {}, 0.0);
   int view = 0;
   for (auto _ : state) {
     const auto v = simulateView(model, stage, {}, sweep, 1, view++, /*threads=*/1);

@@ -1,4 +1,4 @@
-# Unit tests: one gtest executable per test/unit/test_*.cpp, linked against the core only.
+# Unit tests: one gtest executable per test/unit/test_*.cpp, linked against the core and the virtual platform.
 # Node tests: one rostest per test/rostest/*.test, with its gtest node from test/rostest/*.cpp.
 find_package(rostest REQUIRED)
 
@@ -6,7 +6,7 @@ file(GLOB DTM_UNIT_TESTS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/test/unit/test_
 foreach(test_source ${DTM_UNIT_TESTS})
   get_filename_component(test_name ${test_source} NAME_WE)
   catkin_add_gtest(${test_name} ${test_source})
-  target_link_libraries(${test_name} dtm_core ${GTEST_MAIN_LIBRARIES})
+  target_link_libraries(${test_name} dtm_virtual ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(${test_name} PRIVATE
     DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"
     DTM_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config" DTM_TOOL_DIR="${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION}")
@@ -22,7 +22,7 @@ file(GLOB DTM_ROSTEST_NODES
 foreach(test_source ${DTM_ROSTEST_NODES})
   get_filename_component(test_name ${test_source} NAME_WE)
   add_executable(${test_name} EXCLUDE_FROM_ALL ${test_source})
-  target_link_libraries(${test_name} dtm_ros ${GTEST_LIBRARIES})
+  target_link_libraries(${test_name} dtm_ros dtm_virtual ${GTEST_LIBRARIES})
   target_include_directories(${test_name} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
   target_compile_definitions(${test_name} PRIVATE
     DTM_TEST_DATA_DIR="${DTM_TEST_DATA_DIR}" DTM_SHARED_DATA_DIR="${DTM_SHARED_DATA_DIR}"

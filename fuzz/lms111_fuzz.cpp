@@ -13,15 +13,16 @@
 #include <string>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/lms111_emulator.h"
+#include "dormant_tree_modeling/emulation/session_replay.h"
 #include "dormant_tree_modeling/lms111/capture.h"
 #include "dormant_tree_modeling/lms111/cola.h"
-#include "dormant_tree_modeling/lms111/device_emulator.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
-#include "dormant_tree_modeling/lms111/session_replay.h"
 
 using namespace dormant_tree_modeling;
 using namespace dormant_tree_modeling::lms111;
+using namespace dormant_tree_modeling::emulation;
 
 namespace {
 
@@ -83,7 +84,7 @@ void recordingChecked(const std::string& bytes) {
   } catch (const Error&) {
     return;
   }
-  EmulatorSession s;
+  LmsSession s;
   s.protocol = Protocol::COLA_B;
   for (const auto& t : session)
     device->handle(t.payload, s, 1.0);
@@ -109,8 +110,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   sfaCode(Protocol::COLA_B, bytes);
   static auto source = std::make_shared<PatternSource>();
   for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
-    EmulatedLms111 device(EmulatorConfig{}, source);
-    EmulatorSession session;
+    EmulatedLms111 device(LmsEmulatorConfig{}, source);
+    LmsSession session;
     session.protocol = p;
     session.access_level = 3;
     for (const auto& reply : device.handle(bytes, session, 1.0))

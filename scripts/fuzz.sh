@@ -44,9 +44,9 @@ run() {  # name, corpus folder
 
 mkdir -p "$out"
 lms111=()
-for s in cola cola_fields scan_telegram laser_scan device_emulator scan_source capture requests \
-  session_replay; do
-  lms111+=("$root/src/lms111/$s.cpp")
+for s in lms111/cola lms111/cola_fields lms111/scan_telegram lms111/laser_scan lms111/capture \
+  lms111/requests emulation/lms111_emulator emulation/scan_source emulation/session_replay; do
+  lms111+=("$root/src/$s.cpp")
 done
 build lms111_fuzz "${lms111[@]}"
 files=("$root/src/io/point_cloud_io.cpp" "$root/src/io/pcl_file_io.cpp" "$root/src/io/xyz_text_io.cpp"

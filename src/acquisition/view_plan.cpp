@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/yaml_map.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 
 namespace dormant_tree_modeling {
 namespace acquisition {
@@ -54,7 +54,7 @@ std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {
           v.index = static_cast<int>(views.size());
           v.platform_index = platform_index;
           v.side = is_front ? "front" : "back";
-          v.platform = platformPose(x, y, h, yaw);
+          v.platform = geometry::platformPose(x, y, h, yaw);
           v.slide = (s - 0.5 * (config.slide_steps - 1)) * config.slide_step;
           views.push_back(v);
         }

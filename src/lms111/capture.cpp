@@ -197,5 +197,28 @@ std::pair<std::string, std::string> commandWords(const std::string& payload) {
   return {payload.substr(0, a), payload.substr(a + 1, b - a - 1)};
 }
 
+std::string telegramText(const std::string& data) {
+  if (data.find(STX) != std::string::npos) {
+    ColaAFramer framer;
+    framer.feed(data);
+    const auto telegram = framer.next();
+    if (!telegram)
+      throw Error(ErrorCode::PARSE_ERROR, "an STX without its ETX");
+    return *telegram;
+  }
+  std::string text = data;
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
+    text.pop_back();
+  return text;
+}
+
+std::string readTelegramFile(const std::string& path) {
+  return telegramText(readRecording(path, "telegram file"));
+}
+
+std::vector<CapturedTelegram> readSessionFile(const std::string& path) {
+  return readSessionText(readRecording(path, "session file"));
+}
+
 }  // namespace lms111
 }  // namespace dormant_tree_modeling

@@ -58,7 +58,7 @@ VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& p
       pnh.param<std::vector<double>>("platform", {0.0, -1.5, 1.5, 90.0});
   if (start.size() != 4)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~platform takes [x, y, z, yaw_deg]");
-  o.platform = acquisition::platformPose(start[0], start[1], start[2], start[3] * DEG);
+  o.platform = geometry::platformPose(start[0], start[1], start[2], start[3] * DEG);
   o.stage_faults.fault_axis = pnh.param<std::string>("fault_axis", "");
   o.stage_faults.fault_on_move = pnh.param("fault_on_move", 0);
   scene_frame_ = pnh.param<std::string>("scene_frame", "orchard");
@@ -148,7 +148,7 @@ void VirtualPlatformNode::writeLog() {
 bool VirtualPlatformNode::movePlatform(dormant_tree_modeling::MovePlatform::Request& req,
                                        dormant_tree_modeling::MovePlatform::Response& res) {
   try {
-    const Eigen::Isometry3d pose = acquisition::platformPose(req.x, req.y, req.z, req.yaw * DEG);
+    const Eigen::Isometry3d pose = geometry::platformPose(req.x, req.y, req.z, req.yaw * DEG);
     place(pose, nullptr);
     res.success = true;
     res.message = "platform at " + describe(pose);

@@ -53,7 +53,7 @@ Eigen::Isometry3d randomPlatformError(Rng& rng, double max_translation, double m
   const double yaw = rng.uniform(-1.0, 1.0) * max_yaw_deg * M_PI / 180.0;
   // Evaluated in this order so a seed gives the same error on every compiler.
   const double z = rng.uniform(-0.05, 0.05);
-  return acquisition::platformPose(r * std::cos(a), r * std::sin(a), z, yaw);
+  return geometry::platformPose(r * std::cos(a), r * std::sin(a), z, yaw);
 }
 
 DatasetSummary writeDataset(const DatasetOptions& options, const std::string& dir) {
@@ -87,9 +87,9 @@ DatasetSummary writeDataset(const DatasetOptions& options, const std::string& di
       guess_error.push_back(
           randomPlatformError(guess_rng, options.guess_max_translation, options.guess_max_yaw_deg));
     }
-    const Eigen::Isometry3d stage = acquisition::stagePose(v.platform, options.geometry, v.slide);
-    const Eigen::Isometry3d guess_stage = acquisition::stagePose(
-        v.platform * guess_error[v.platform_index], options.geometry, v.slide);
+    const Eigen::Isometry3d stage = geometry::stagePose(v.platform, options.geometry, v.slide);
+    const Eigen::Isometry3d guess_stage =
+        geometry::stagePose(v.platform * guess_error[v.platform_index], options.geometry, v.slide);
     const SimulatedView sim = simulateView(model, stage, options.geometry, options.plan,
                                            options.seed, v.index, options.threads);
     // The tree and its surroundings lie in 0 <= phi < 180 deg; the rest looks behind the sensor.

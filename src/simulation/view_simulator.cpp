@@ -8,7 +8,7 @@ namespace dormant_tree_modeling {
 namespace simulation {
 
 SimulatedView simulateView(const Lms111Model& model, const Eigen::Isometry3d& stage_pose,
-                           const acquisition::StageGeometry& geometry,
+                           const geometry::StageGeometry& geometry,
                            const acquisition::ViewPlanConfig& sweep, std::uint64_t seed,
                            int view_index, int threads) {
   constexpr double DEG = M_PI / 180.0;
@@ -29,7 +29,7 @@ SimulatedView simulateView(const Lms111Model& model, const Eigen::Isometry3d& st
       [&](int i) {
         Rng rng = Rng::derive(seed, 7, static_cast<std::uint64_t>(view_index),
                               static_cast<std::uint64_t>(i));
-        const auto laser = acquisition::laserPose(stage_pose, geometry, image.theta(i));
+        const auto laser = geometry::laserPose(stage_pose, geometry, image.theta(i));
         const ScanLine line = model.scanLine(laser, rng);
         const std::size_t base = static_cast<std::size_t>(i) * cols;
         for (int j = 0; j < cols; ++j) {

@@ -1,7 +1,7 @@
 #include "dormant_tree_modeling/simulation/virtual_platform.h"
 
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+#include "dormant_tree_modeling/simulation/simulated_scan_source.h"
 
 namespace dormant_tree_modeling {
 namespace simulation {
@@ -10,17 +10,17 @@ VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOption
   if (o.scan_frequency_hz != 25.0 && o.scan_frequency_hz != 50.0)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the LMS111 runs at 25 or 50 Hz");
   ensemble_ =
-      std::make_shared<aerotech::EmulatedEnsemble>(aerotech::defaultStageAxes(), o.stage_faults);
-  stage_ = std::make_unique<aerotech::EnsembleServer>(ensemble_, "127.0.0.1", o.stage_port);
+      std::make_shared<emulation::EmulatedEnsemble>(emulation::defaultStageAxes(), o.stage_faults);
+  stage_ = std::make_unique<emulation::EnsembleServer>(ensemble_, "127.0.0.1", o.stage_port);
 
   Lms111Config sensor;
   sensor.range_noise_sigma = o.range_noise_sigma;
   const double period = 1.0 / o.scan_frequency_hz;
-  aerotech::EnsembleServer* stage = stage_.get();
+  emulation::EnsembleServer* stage = stage_.get();
   auto ensemble = ensemble_;
   setPlatform(o.platform);
   std::shared_ptr<PlatformState> state = platform_;
-  const acquisition::StageGeometry geometry = o.geometry;
+  const geometry::StageGeometry geometry = o.geometry;
   // The middle beam (135 of the mirror's 360 deg after the first ray) looks at the tree.
   auto pose = [stage, ensemble, state, geometry, period](double) {
     const double t = stage->now() + 0.375 * period;
@@ -31,14 +31,13 @@ VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOption
       std::lock_guard<std::mutex> lock(state->mutex);
       platform = state->pose;
     }
-    return acquisition::laserPose(acquisition::stagePose(platform, geometry, slide_m), geometry,
-                                  theta);
+    return geometry::laserPose(geometry::stagePose(platform, geometry, slide_m), geometry, theta);
   };
-  auto source = std::make_shared<lms111::SimulatedScanSource>(scene, pose, sensor, o.seed);
-  lms111::EmulatorConfig device;
+  auto source = std::make_shared<SimulatedScanSource>(scene, pose, sensor, o.seed);
+  emulation::LmsEmulatorConfig device;
   device.scan.frequency = device.scan.resolution = o.scan_frequency_hz == 25.0 ? 2500 : 5000;
-  laser_ = std::make_unique<lms111::EmulatorServer>(
-      std::make_shared<lms111::EmulatedLms111>(device, source, o.laser_faults), o.laser);
+  laser_ = std::make_unique<emulation::LmsServer>(
+      std::make_shared<emulation::EmulatedLms111>(device, source, o.laser_faults), o.laser);
 }
 
 void VirtualPlatform::setPlatform(const Eigen::Isometry3d& platform) {

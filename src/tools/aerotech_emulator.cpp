@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include "command_line.h"
-#include "dormant_tree_modeling/aerotech/ensemble_server.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/ensemble_server.h"
 #include "serve_loop.h"
 
 namespace po = boost::program_options;
@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   std::string address = "127.0.0.1";
   int port = 8000;
   double duration = 0.0;
-  aerotech::EnsembleFaults faults;
+  emulation::EnsembleFaults faults;
   std::vector<std::string> invalid;
   po::options_description desc(
       "Usage: aerotech_emulator [options]\n"
@@ -43,8 +43,8 @@ int main(int argc, char** argv) {
                   "--port must be in 0..65535, not " + std::to_string(port));
     faults.invalid_commands.insert(invalid.begin(), invalid.end());
     auto controller =
-        std::make_shared<aerotech::EmulatedEnsemble>(aerotech::defaultStageAxes(), faults);
-    aerotech::EnsembleServer server(controller, address, port);
+        std::make_shared<emulation::EmulatedEnsemble>(emulation::defaultStageAxes(), faults);
+    emulation::EnsembleServer server(controller, address, port);
     std::cout << "aerotech_emulator: listening on " << address << ":" << server.port() << std::endl;
     tools::serveUntilStopped(duration);
     server.stop();

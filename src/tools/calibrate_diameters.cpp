@@ -6,8 +6,8 @@
 #include <iostream>
 
 #include "command_line.h"
+#include "dormant_tree_modeling/calibration/rig_calibration.h"
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/evaluation/rig_calibration.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 
@@ -18,18 +18,18 @@ namespace {
 
 /// A rig scan in double precision in the rig file's frame: a cloud (its offset put back) or a
 /// folder of views (views.json; each view by its true or registered pose).
-evaluation::RigScan readRigScan(const std::string& path, const std::string& rig_path) {
+calibration::RigScan readRigScan(const std::string& path, const std::string& rig_path) {
   const auto rig = io::readTruthFile(rig_path);
   if (std::filesystem::is_directory(path))
-    return evaluation::readRigViews(path, rig);
-  evaluation::RigScan scan;
+    return calibration::readRigViews(path, rig);
+  calibration::RigScan scan;
   scan.name = path;
   scan.rig = rig;
   scan.points = io::readPointsInFileFrame(path);
   return scan;
 }
 
-void printSamples(const evaluation::RigCalibrationResult& result) {
+void printSamples(const calibration::RigCalibrationResult& result) {
   std::cerr
       << "part     id  true r mm  apparent mm  noise est mm  noise part mm  footprint mm  scan\n";
   for (const auto& s : result.samples) {
@@ -64,7 +64,7 @@ void printSamples(const evaluation::RigCalibrationResult& result) {
 int main(int argc, char** argv) {
   std::vector<std::string> scans, rigs;
   std::string output, params, name = "rig_calibration";
-  evaluation::RigSearch search;
+  calibration::RigSearch search;
   po::options_description desc(
       "Usage: calibrate_diameters --scan CLOUD --truth RIG.json [--scan CLOUD --truth RIG.json "
       "...] --output calibration.yaml [--name NAME] [--params FILE]\n"
@@ -93,10 +93,10 @@ int main(int argc, char** argv) {
       throw po::error("--axis-tolerance-m must be in (0, 0.5]");
     const modeling::ModelerConfig config =
         params.empty() ? modeling::ModelerConfig{} : modeling::loadModelerConfig(params);
-    std::vector<evaluation::RigScan> rig_scans;
+    std::vector<calibration::RigScan> rig_scans;
     for (std::size_t i = 0; i < scans.size(); ++i)
       rig_scans.push_back(readRigScan(scans[i], rigs[i]));
-    const auto result = evaluation::calibrateFromRig(rig_scans, config, name, search);
+    const auto result = calibration::calibrateFromRig(rig_scans, config, name, search);
     printSamples(result);
     for (const auto& w : result.warnings)
       std::cerr << "calibrate_diameters: warning: " << w << "\n";

@@ -9,8 +9,8 @@
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/scan_source.h"
 #include "dormant_tree_modeling/lms111/capture.h"
-#include "dormant_tree_modeling/lms111/scan_source.h"
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
 
 namespace po = boost::program_options;

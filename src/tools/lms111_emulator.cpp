@@ -5,19 +5,19 @@
 
 #include "command_line.h"
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/lms111/emulator_server.h"
-#include "dormant_tree_modeling/lms111/session_replay.h"
-#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+#include "dormant_tree_modeling/emulation/lms111_server.h"
+#include "dormant_tree_modeling/emulation/session_replay.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
+#include "dormant_tree_modeling/simulation/simulated_scan_source.h"
 #include "serve_loop.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
 int main(int argc, char** argv) {
-  lms111::EmulatorServerOptions server;
-  lms111::EmulatorConfig device;
-  lms111::EmulatorFaults faults;
+  emulation::LmsServerOptions server;
+  emulation::LmsEmulatorConfig device;
+  emulation::LmsFaults faults;
   std::string telegram, session, scene_path, preset = "young_tall_spindle";
   std::uint64_t seed = 1;
   double distance = 1.5, height = 1.5, noise_mm = 12.0, frequency = 25.0, duration = 0.0;
@@ -83,25 +83,25 @@ int main(int argc, char** argv) {
         throw Error(ErrorCode::INVALID_ARGUMENT,
                     "ports must be in 0..65535 (or -1: off), not " + std::to_string(port));
     }
-    std::shared_ptr<lms111::EmulatedLms111> emulated;
-    std::shared_ptr<lms111::ScanSource> source;
+    std::shared_ptr<emulation::EmulatedLms111> emulated;
+    std::shared_ptr<emulation::ScanSource> source;
     if (!session.empty()) {
-      emulated = lms111::makeSessionReplay(lms111::readSessionFile(session), device, faults);
+      emulated = emulation::makeSessionReplay(lms111::readSessionFile(session), device, faults);
     } else if (!telegram.empty()) {
-      source = std::make_shared<lms111::RecordedScanSource>(
-          lms111::RecordedScanSource::fromFile(telegram));
+      source = std::make_shared<emulation::RecordedScanSource>(
+          emulation::RecordedScanSource::fromFile(telegram));
     } else {
       const simulation::Scene scene =
           simulation::sceneFromFileOrPreset(scene_path, preset, seed).scene;
       simulation::Lms111Config sensor;
       sensor.range_noise_sigma = noise_mm / 1000.0;
-      const Eigen::Isometry3d pose = lms111::SimulatedScanSource::frontView(distance, height);
-      source = std::make_shared<lms111::SimulatedScanSource>(
+      const Eigen::Isometry3d pose = simulation::SimulatedScanSource::frontView(distance, height);
+      source = std::make_shared<simulation::SimulatedScanSource>(
           scene, [pose](double) { return pose; }, sensor, seed);
     }
     if (!emulated)
-      emulated = std::make_shared<lms111::EmulatedLms111>(device, source, faults);
-    lms111::EmulatorServer running(emulated, server);
+      emulated = std::make_shared<emulation::EmulatedLms111>(device, source, faults);
+    emulation::LmsServer running(emulated, server);
     std::cout << "lms111_emulator: listening on " << server.address << ", CoLa-A port "
               << running.colaAPort() << ", CoLa-B port " << running.colaBPort() << std::endl;
     tools::serveUntilStopped(duration);

@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 
@@ -80,7 +80,7 @@ TEST(ViewAcquisition, OnTheVirtualPlatform) {
   ASSERT_GT(cloud.size(), 1000u);
   // The virtual platform's orchard and platform pose (its defaults; seed 3).
   const simulation::Orchard orchard = simulation::generateOrchard({}, 3);
-  const Eigen::Isometry3d platform = acquisition::platformPose(0.0, -1.5, 1.5, M_PI / 2);
+  const Eigen::Isometry3d platform = geometry::platformPose(0.0, -1.5, 1.5, M_PI / 2);
   std::vector<double> d;
   for (const auto& p : cloud)
     d.push_back(surfaceDistance(orchard.scene.trees[0], platform * Eigen::Vector3d(p.x, p.y, p.z)));

@@ -11,13 +11,15 @@
 
 #include "dormant_tree_modeling/aerotech/ascii_protocol.h"
 #include "dormant_tree_modeling/aerotech/ensemble_client.h"
-#include "dormant_tree_modeling/aerotech/ensemble_server.h"
 #include "dormant_tree_modeling/aerotech/stage_controller.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/ensemble_server.h"
 
 namespace dormant_tree_modeling {
 namespace aerotech {
 namespace {
+
+using namespace emulation;  // the tests run the driver against the device emulators
 
 TEST(AerotechProtocol, RepliesStatusAndFaults) {
   const Reply q = parseReply("%12.3450");

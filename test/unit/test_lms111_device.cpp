@@ -5,14 +5,16 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/emulation/lms111_emulator.h"
 #include "dormant_tree_modeling/lms111/clock_mapper.h"
 #include "dormant_tree_modeling/lms111/cola_fields.h"
-#include "dormant_tree_modeling/lms111/device_emulator.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {
 namespace {
+
+using namespace emulation;  // the tests run the driver against the device emulators
 
 std::shared_ptr<ScanSource> recorded() {
   return std::make_shared<RecordedScanSource>(RecordedScanSource::fromFile(
@@ -23,8 +25,8 @@ std::shared_ptr<ScanSource> recorded() {
 class DeviceFixture : public ::testing::Test {
  protected:
   DeviceFixture() : device_(config(), recorded()) {}
-  static EmulatorConfig config() {
-    EmulatorConfig c;
+  static LmsEmulatorConfig config() {
+    LmsEmulatorConfig c;
     c.spin_up_seconds = 1.0;
     return c;
   }
@@ -33,7 +35,7 @@ class DeviceFixture : public ::testing::Test {
     return replies.empty() ? std::string() : replies.front();
   }
   EmulatedLms111 device_;
-  EmulatorSession session_;
+  LmsSession session_;
 };
 
 TEST_F(DeviceFixture, ConfigurationNeedsTheAuthorisedClientLevel) {
@@ -89,12 +91,12 @@ TEST_F(DeviceFixture, ScansFollowTheConfigurationAndCountersAdvance) {
 }
 
 TEST_F(DeviceFixture, ColaBRepliesAndInjectedSfa) {
-  EmulatorFaults faults;
+  LmsFaults faults;
   faults.addSfa("mLMPsetscancfg:4:1");
   EXPECT_THROW(faults.addSfa("mLMPsetscancfg"), Error);
   EXPECT_THROW(faults.addSfa("Run:x"), Error);
   EmulatedLms111 device(config(), recorded(), faults);
-  EmulatorSession b;
+  LmsSession b;
   b.protocol = Protocol::COLA_B;
   auto ask_b = [&](const std::function<void(FieldWriter&)>& write) {
     ColaBWriter w;

@@ -9,12 +9,14 @@
 #include <thread>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/lms111_server.h"
 #include "dormant_tree_modeling/lms111/driver.h"
-#include "dormant_tree_modeling/lms111/emulator_server.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {
 namespace {
+
+using namespace emulation;  // the tests run the driver against the device emulators
 
 using Seconds = std::chrono::duration<double>;
 
@@ -59,15 +61,15 @@ struct Sink {
 };
 
 struct Bench {
-  explicit Bench(EmulatorFaults faults = {}, double frequency_hz = 50.0) {
-    EmulatorConfig c;
+  explicit Bench(LmsFaults faults = {}, double frequency_hz = 50.0) {
+    LmsEmulatorConfig c;
     c.spin_up_seconds = 0.05;
     c.scan.frequency = c.scan.resolution = frequency_hz == 50.0 ? 5000 : 2500;
     device = std::make_shared<EmulatedLms111>(c, recorded(), faults);
-    EmulatorServerOptions o;
+    LmsServerOptions o;
     o.cola_a_port = 0;
     o.cola_b_port = 0;
-    server = std::make_unique<EmulatorServer>(device, o);
+    server = std::make_unique<LmsServer>(device, o);
   }
   DriverConfig driverConfig(Protocol protocol = Protocol::COLA_A) const {
     DriverConfig d;
@@ -82,7 +84,7 @@ struct Bench {
     return d;
   }
   std::shared_ptr<EmulatedLms111> device;
-  std::unique_ptr<EmulatorServer> server;
+  std::unique_ptr<LmsServer> server;
 };
 
 TEST(Lms111Driver, StreamsTheRequestedScansInBothProtocols) {
@@ -126,7 +128,7 @@ TEST(Lms111Driver, StreamsTheRequestedScansInBothProtocols) {
 }
 
 TEST(Lms111Driver, ReconnectsAfterTheDeviceDropsTheConnectionOrGoesSilent) {
-  EmulatorFaults faults;
+  LmsFaults faults;
   faults.drop_after = 10;
   faults.stall_after = 30;
   faults.stall_seconds = 1.0;
@@ -146,7 +148,7 @@ TEST(Lms111Driver, ReconnectsAfterTheDeviceDropsTheConnectionOrGoesSilent) {
 
 TEST(Lms111Driver, SurvivesTrickledAndCorruptedBytes) {
   for (const Protocol p : {Protocol::COLA_A, Protocol::COLA_B}) {
-    EmulatorFaults faults;
+    LmsFaults faults;
     faults.trickle_bytes = 500;
     faults.corrupt_every = 4;
     Bench bench(faults);
@@ -166,7 +168,7 @@ TEST(Lms111Driver, SfaOnConfigurationGivesAClearErrorAndARetry) {
   // The device powers up at 25 Hz and refuses the first mLMPsetscancfg (as some firmware
   // does after power-up): the driver finds it running the wrong configuration, says so,
   // and succeeds on the next attempt.
-  EmulatorFaults faults;
+  LmsFaults faults;
   faults.addSfa("mLMPsetscancfg:4:1");
   Bench bench(faults, 25.0);
   Sink sink;
@@ -182,7 +184,7 @@ TEST(Lms111Driver, SfaOnConfigurationGivesAClearErrorAndARetry) {
 }
 
 TEST(Lms111Driver, RecoversFromADeviceRebootAndResetsTheClock) {
-  EmulatorFaults faults;
+  LmsFaults faults;
   faults.restart_after = 10;
   faults.restart_seconds = 0.3;
   Bench bench(faults);

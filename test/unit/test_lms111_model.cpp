@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/lms111_model.h"
 #include "dormant_tree_modeling/simulation/view_simulator.h"
 
@@ -14,8 +14,7 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 
 Eigen::Isometry3d laserAt(double x, double y, double z, double yaw = 0.0) {
-  return acquisition::laserPose(acquisition::platformPose(x, y, z, yaw),
-                                acquisition::StageGeometry{}, 0.0);
+  return geometry::laserPose(geometry::platformPose(x, y, z, yaw), geometry::StageGeometry{}, 0.0);
 }
 
 Scene groundOnly() {
@@ -140,13 +139,13 @@ TEST(Lms111Model, MixedPixelsOnlyAtDepthEdges) {
   acquisition::ViewPlanConfig sweep;
   sweep.theta_min_deg = -10.0;
   sweep.theta_max_deg = 10.0;
-  const auto stage = acquisition::stagePose(acquisition::platformPose(0, 0, 1.0, 0), {}, 0.0);
+  const auto stage = geometry::stagePose(geometry::platformPose(0, 0, 1.0, 0), {}, 0.0);
   const SimulatedView view = simulateView(model, stage, {}, sweep, 3, 0, 1);
   const auto& img = view.image;
   // Distance of each pixel's central ray: the surface a thin beam would measure.
   std::vector<double> centre(img.range.size(), -1.0);
   for (int i = 0; i < img.rows; ++i) {
-    const auto laser = acquisition::laserPose(stage, {}, img.theta(i));
+    const auto laser = geometry::laserPose(stage, {}, img.theta(i));
     for (int j = 0; j < img.cols; ++j) {
       const double phi = img.phi(j);
       const Ray ray{laser.translation(),
@@ -189,8 +188,7 @@ TEST(ViewSimulator, FullViewIsA200By1080ImageIndependentOfThreads) {
   const RayCaster caster(scene);
   const Lms111Model model(caster, Lms111Config{});
   const acquisition::ViewPlanConfig sweep;
-  const auto stage =
-      acquisition::stagePose(acquisition::platformPose(0, -1.5, 1.5, M_PI / 2), {}, 0.0);
+  const auto stage = geometry::stagePose(geometry::platformPose(0, -1.5, 1.5, M_PI / 2), {}, 0.0);
   const SimulatedView one = simulateView(model, stage, {}, sweep, 9, 4, 1);
   const SimulatedView two = simulateView(model, stage, {}, sweep, 9, 4, 2);
   EXPECT_EQ(one.image.rows, 200);

@@ -10,15 +10,17 @@
 #include <mutex>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/emulation/lms111_server.h"
+#include "dormant_tree_modeling/emulation/session_replay.h"
 #include "dormant_tree_modeling/lms111/capture.h"
 #include "dormant_tree_modeling/lms111/driver.h"
-#include "dormant_tree_modeling/lms111/emulator_server.h"
 #include "dormant_tree_modeling/lms111/requests.h"
-#include "dormant_tree_modeling/lms111/session_replay.h"
 
 namespace dormant_tree_modeling {
 namespace lms111 {
 namespace {
+
+using namespace emulation;  // the tests run the driver against the device emulators
 
 std::string sessionPath() {
   return std::string(DTM_SHARED_DATA_DIR) + "/lms1xx/lms511_session_colab.txt";
@@ -118,20 +120,20 @@ TEST(Requests, ScanDataConfigInCoLaAIsTheDocumentedTwelveFields) {
   EXPECT_TRUE(reader.atEnd()) << ours;
 }
 
-std::string ask(EmulatedLms111& device, EmulatorSession& session, const std::string& payload) {
+std::string ask(EmulatedLms111& device, LmsSession& session, const std::string& payload) {
   return device.handle(payload, session, 1.0).back();
 }
 
 TEST(EmulatedLms111, RefusesTheOldScanDataConfigLayoutsAsTheDeviceDoes) {
   auto device = makeSessionReplay(realSession());
   auto plain = std::make_shared<EmulatedLms111>(
-      EmulatorConfig{}, std::make_shared<RecordedScanSource>(
-                            parseScanTelegram(recordedScans().front()->payload, Protocol::COLA_B)));
+      LmsEmulatorConfig{}, std::make_shared<RecordedScanSource>(parseScanTelegram(
+                               recordedScans().front()->payload, Protocol::COLA_B)));
   for (EmulatedLms111* d : {device.get(), plain.get()}) {
-    EmulatorSession a, b;
+    LmsSession a, b;
     a.protocol = Protocol::COLA_A;
     b.protocol = Protocol::COLA_B;
-    for (EmulatorSession* s : {&a, &b})
+    for (LmsSession* s : {&a, &b})
       ASSERT_EQ(ask(*d, *s, loginRequest(s->protocol)).substr(0, 17), "sAN SetAccessMode");
     // The channel as one 16-bit value and the encoder as one value: 10 fields in CoLa-A.
     EXPECT_EQ(ask(*d, a, "sWN LMDscandatacfg 1 1 0 0 0 0 0 0 0 1").substr(0, 3), "sFA");
@@ -151,7 +153,7 @@ TEST(EmulatedLms111, RefusesTheOldScanDataConfigLayoutsAsTheDeviceDoes) {
 
 TEST(SessionReplay, AnswersWhatTheRecordedHostAskedWithTheRecordedReplies) {
   auto device = makeSessionReplay(realSession());
-  EmulatorSession s;
+  LmsSession s;
   s.protocol = Protocol::COLA_B;
   const auto replies = device->handle(recorded("sMN SetAccessMode "), s, 1.0);
   ASSERT_EQ(replies.size(), 2u);
@@ -189,9 +191,9 @@ struct Sink {
 };
 
 DriverStatistics streamFrom(std::shared_ptr<EmulatedLms111> device, Protocol protocol, Sink& sink) {
-  EmulatorServerOptions options;
+  LmsServerOptions options;
   options.cola_a_port = options.cola_b_port = 0;
-  EmulatorServer server(device, options);
+  LmsServer server(device, options);
   DriverConfig config;
   config.host = "127.0.0.1";
   config.protocol = protocol;
@@ -207,7 +209,7 @@ DriverStatistics streamFrom(std::shared_ptr<EmulatedLms111> device, Protocol pro
 }
 
 TEST(SessionReplay, TheDriverStreams541BeamsAt50HzFromTheRealSessionInCoLaB) {
-  EmulatorConfig config;
+  LmsEmulatorConfig config;
   config.spin_up_seconds = 0.05;
   config.reported_angle_error = 3;  // as a real LMS111 reports its range
   Sink sink;
@@ -237,7 +239,7 @@ TEST(SessionReplay, TheDriverStreams541BeamsAt50HzFromTheRealSessionInCoLaB) {
 TEST(SessionReplay, TheDriverStreamsTheRecordedCoLaATelegramInCoLaA) {
   const auto recorded_scan = parseScanTelegram(
       readTelegramFile(std::string(DTM_SHARED_DATA_DIR) + "/lms1xx/lms1xx_scan_541pts.txt"));
-  EmulatorConfig config;
+  LmsEmulatorConfig config;
   config.spin_up_seconds = 0.05;
   config.reported_angle_error = 3;
   Sink sink;

@@ -34,7 +34,7 @@ Points viewOfTree(const simulation::Lms111Model& model, const Eigen::Isometry3d&
   acquisition::ViewPlanConfig sweep;
   sweep.theta_step_deg = theta_step_deg;
   const auto view =
-      simulation::simulateView(model, stage, acquisition::StageGeometry{}, sweep, 7, index, 2);
+      simulation::simulateView(model, stage, geometry::StageGeometry{}, sweep, 7, index, 2);
   Points pts;
   for (int i = 0; i < view.image.rows; ++i) {
     for (int j = 0; j < view.image.cols; ++j) {
@@ -63,8 +63,8 @@ TEST(PointToPlaneIcp, RecoversTheRelativePoseOfTwoViews) {
   sensor.range_noise_sigma = 0.006;
   const simulation::Lms111Model model(caster, sensor);
   // Two platform positions 1 m apart along the row, in front of the tree.
-  const Eigen::Isometry3d a = acquisition::platformPose(-0.5, -1.5, 1.5, M_PI / 2);
-  const Eigen::Isometry3d b = acquisition::platformPose(0.5, -1.5, 1.5, M_PI / 2 + 0.3);
+  const Eigen::Isometry3d a = geometry::platformPose(-0.5, -1.5, 1.5, M_PI / 2);
+  const Eigen::Isometry3d b = geometry::platformPose(0.5, -1.5, 1.5, M_PI / 2 + 0.3);
   const Points target = viewOfTree(model, a, 0), source = viewOfTree(model, b, 1);
   ASSERT_GT(target.size(), 1000u);
   ASSERT_GT(source.size(), 1000u);
@@ -116,7 +116,7 @@ class MultiView : public ::testing::Test {
     v.station = id;
     v.points = viewOfTree(*model_, platform, id, object, 0.45);
     if (hinted)
-      v.station_hint = platform * acquisition::platformPose(dx, dy, 0.0, yaw_deg * M_PI / 180);
+      v.station_hint = platform * geometry::platformPose(dx, dy, 0.0, yaw_deg * M_PI / 180);
     return v;
   }
 
@@ -148,10 +148,10 @@ simulation::Orchard* MultiView::orchard_ = nullptr;
 simulation::RayCaster* MultiView::caster_ = nullptr;
 simulation::Lms111Model* MultiView::model_ = nullptr;
 
-const Eigen::Isometry3d FRONT_LEFT = acquisition::platformPose(-0.5, -1.5, 1.5, M_PI / 2);
-const Eigen::Isometry3d FRONT_RIGHT = acquisition::platformPose(0.5, -1.5, 1.5, M_PI / 2 + 0.2);
-const Eigen::Isometry3d BACK_LEFT = acquisition::platformPose(-0.4, 1.5, 1.5, -M_PI / 2);
-const Eigen::Isometry3d BACK_RIGHT = acquisition::platformPose(0.6, 1.5, 1.5, -M_PI / 2 - 0.1);
+const Eigen::Isometry3d FRONT_LEFT = geometry::platformPose(-0.5, -1.5, 1.5, M_PI / 2);
+const Eigen::Isometry3d FRONT_RIGHT = geometry::platformPose(0.5, -1.5, 1.5, M_PI / 2 + 0.2);
+const Eigen::Isometry3d BACK_LEFT = geometry::platformPose(-0.4, 1.5, 1.5, -M_PI / 2);
+const Eigen::Isometry3d BACK_RIGHT = geometry::platformPose(0.6, 1.5, 1.5, -M_PI / 2 - 0.1);
 
 TEST_F(MultiView, RecoversStationsFromHintsHalfAMetreAndTwentyDegreesOff) {
   // Every hint off by 0.5 m and 20 deg, in different directions.
@@ -211,8 +211,7 @@ TEST_F(MultiView, LeavesOutAViewOfAnotherTreeAndAViewOfNothing) {
   // saw (almost) nothing.
   ASSERT_GT(orchard_->scene.trees.size(), 1u);
   const Eigen::Vector3d neighbour = orchard_->scene.trees[1].branches.front().points.front();
-  const Eigen::Isometry3d at_neighbour =
-      acquisition::platformPose(neighbour.x(), -1.5, 1.5, M_PI / 2);
+  const Eigen::Isometry3d at_neighbour = geometry::platformPose(neighbour.x(), -1.5, 1.5, M_PI / 2);
   std::vector<ViewInput> views = {station(FRONT_LEFT, 0, 0, 0, 0),
                                   station(FRONT_RIGHT, 1, 0.1, 0, 5),
                                   station(at_neighbour, 2, 0, 0, 0, true, 1)};

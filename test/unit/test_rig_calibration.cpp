@@ -5,9 +5,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "dormant_tree_modeling/calibration/rig_calibration.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
-#include "dormant_tree_modeling/evaluation/rig_calibration.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
@@ -21,7 +21,7 @@
 namespace dormant_tree_modeling {
 namespace {
 
-using evaluation::RigScan;
+using calibration::RigScan;
 
 TEST(NoiseBias, ThickSectionsAreUnbiasedAndThinRodsWidenWithTheNoise) {
   const modeling::ModelerConfig config;
@@ -166,7 +166,7 @@ test::TempDir* RigCalibration::dir_ = nullptr;
 RigScan* RigCalibration::scan_ = nullptr;
 
 TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
-  const auto result = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  const auto result = calibration::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
   ASSERT_EQ(result.warnings.size(), 1u);  // a cloud: no silhouette
   EXPECT_NE(result.warnings[0].find("given as a cloud"), std::string::npos);
   int sections = 0, rods = 0;
@@ -189,9 +189,9 @@ TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
 }
 
 TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
-  const RigScan views = evaluation::readRigViews(dir_->file("rig"), scan_->rig);
+  const RigScan views = calibration::readRigViews(dir_->file("rig"), scan_->rig);
   EXPECT_EQ(views.views.size(), 40u);
-  const auto r = evaluation::calibrateFromRig({views}, modeling::ModelerConfig{}, "sim");
+  const auto r = calibration::calibrateFromRig({views}, modeling::ModelerConfig{}, "sim");
   const auto& s = r.calibration.silhouette;
   ASSERT_TRUE(s.measured);
   // Our sensor model's beam: 8 mm + 15 mrad, 38 mm across at 2 m; a beam a few tenths on a rod
@@ -205,7 +205,7 @@ TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
   EXPECT_GT(s.depth_share, 0.3);
   EXPECT_LT(s.depth_share, 0.9);
   // The same rig as a cloud cannot tell the sides apart: said, and nothing measured.
-  const auto cloud = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  const auto cloud = calibration::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
   EXPECT_FALSE(cloud.calibration.silhouette.measured);
   ASSERT_EQ(cloud.warnings.size(), 1u);
   EXPECT_NE(cloud.warnings[0].find("not calibrated"), std::string::npos);
@@ -224,8 +224,8 @@ TEST_F(RigCalibration, SurveyCoordinatesGiveTheSameCalibration) {
     for (auto& p : b.points)
       p += offset;
   }
-  const auto a = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "a");
-  const auto b = evaluation::calibrateFromRig({far}, modeling::ModelerConfig{}, "b");
+  const auto a = calibration::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "a");
+  const auto b = calibration::calibrateFromRig({far}, modeling::ModelerConfig{}, "b");
   ASSERT_EQ(a.calibration.branch_footprint.bias.size(), b.calibration.branch_footprint.bias.size());
   for (std::size_t i = 0; i < a.calibration.branch_footprint.bias.size(); ++i)
     EXPECT_NEAR(a.calibration.branch_footprint.bias[i], b.calibration.branch_footprint.bias[i],
@@ -237,7 +237,7 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
   // An empty scan.
   RigScan empty = *scan_;
   empty.points.clear();
-  EXPECT_THROW(evaluation::calibrateFromRig({empty}, config, "x"), Error);
+  EXPECT_THROW(calibration::calibrateFromRig({empty}, config, "x"), Error);
   // Rods that are not in the scan: the rig file's rods 1.5 m beside the pipe.
   RigScan turned = *scan_;
   for (auto& b : turned.rig.primary_branches) {
@@ -245,7 +245,7 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
       p.x() += 1.5;
   }
   try {
-    evaluation::calibrateFromRig({turned}, config, "x");
+    calibration::calibrateFromRig({turned}, config, "x");
     FAIL() << "a table from rods that are not there";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::NO_TRUNK);
@@ -255,14 +255,14 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
   RigScan off = *scan_;
   for (auto& p : off.rig.primary_branches[4].points)
     p.x() += 0.2;
-  const auto r = evaluation::calibrateFromRig({off}, config, "x");
+  const auto r = calibration::calibrateFromRig({off}, config, "x");
   ASSERT_EQ(r.warnings.size(), 2u);  // and the cloud's silhouette
   EXPECT_NE(r.warnings[0].find("rod 4 "), std::string::npos) << r.warnings[0];
   // A pipe of one diameter: said, and the table is constant over radius.
   RigScan one = *scan_;
   one.rig.trunk.points = {one.rig.trunk.points[6], one.rig.trunk.points[7]};
   one.rig.trunk.diameters = {0.06, 0.06};
-  const auto single = evaluation::calibrateFromRig({one}, config, "x");
+  const auto single = calibration::calibrateFromRig({one}, config, "x");
   bool said = false;
   for (const auto& w : single.warnings)
     said = said || w.find("one diameter") != std::string::npos;
@@ -271,11 +271,11 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
   // No pipe section long enough, or no rods: not a rig.
   RigScan bare = *scan_;
   bare.rig.primary_branches.clear();
-  EXPECT_THROW(evaluation::calibrateFromRig({bare}, config, "x"), Error);
+  EXPECT_THROW(calibration::calibrateFromRig({bare}, config, "x"), Error);
 }
 
 TEST_F(RigCalibration, ATreeOfTheSameWorldMeasuresWithinBoundsAndSaysWhichCalibration) {
-  auto result = evaluation::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
+  auto result = calibration::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
   result.calibration.hash = "0123456789abcdef";
   simulation::DatasetOptions o;
   o.seed = 41;  // not a bench tree

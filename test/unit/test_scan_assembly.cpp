@@ -153,11 +153,11 @@ LabelledView labelledView(const simulation::Orchard& orchard, const Eigen::Isome
   sensor.angular_resolution_deg = 0.5;
   sensor.scan_frequency_hz = 50.0;
   const simulation::Lms111Model model(caster, sensor);
-  const StageGeometry geometry;
+  const geometry::StageGeometry geometry;
   ViewPlanConfig sweep;
   sweep.theta_step_deg = 0.9;
   const simulation::SimulatedView view = simulation::simulateView(
-      model, stagePose(platform, geometry, 0.0), geometry, sweep, seed, 0, 2);
+      model, geometry::stagePose(platform, geometry, 0.0), geometry, sweep, seed, 0, 2);
   LabelledView out;
   for (int i = 0; i < view.image.rows; ++i) {
     for (int j = 0; j < view.image.cols; ++j) {
@@ -194,7 +194,7 @@ TEST(TargetIsolation, HighViewsBesideTheTreeWithTheOperatorsError) {
     simulation::OrchardConfig oc;
     const simulation::Orchard orchard = simulation::generateOrchard(oc, seed);
     for (double x : {-0.5, 0.5}) {
-      const Eigen::Isometry3d plan = platformPose(x, -1.5, 4.0, M_PI / 2);
+      const Eigen::Isometry3d plan = geometry::platformPose(x, -1.5, 4.0, M_PI / 2);
       const Eigen::Isometry3d platform = plan * simulation::randomPlatformError(rng, 0.2, 8.0);
       const LabelledView v = labelledView(orchard, platform, seed);
       const Eigen::Vector2d hint = (plan.inverse() * Eigen::Vector3d::Zero()).head<2>();
@@ -220,7 +220,7 @@ TEST(TargetIsolation, TakesThePlansGroundWhenNoneIsSeen) {
   simulation::OrchardConfig oc;
   oc.ground = false;
   const simulation::Orchard orchard = simulation::generateOrchard(oc, 1);
-  const LabelledView v = labelledView(orchard, platformPose(0.0, -1.5, 4.0, M_PI / 2), 1);
+  const LabelledView v = labelledView(orchard, geometry::platformPose(0.0, -1.5, 4.0, M_PI / 2), 1);
   const IsolationResult without =
       isolateTarget(v.cloud, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), {1.5, 0.0}, {});
   const IsolationResult with = isolateTarget(v.cloud, Eigen::Vector3d::Zero(),
@@ -250,7 +250,8 @@ TEST(TargetIsolation, CutsTheTargetTreeOutOfOrchardViews) {
     simulation::OrchardConfig oc;
     oc.preset = preset;
     const simulation::Orchard orchard = simulation::generateOrchard(oc, seed);
-    const LabelledView v = labelledView(orchard, platformPose(0.0, -1.5, 1.5, M_PI / 2), seed);
+    const LabelledView v =
+        labelledView(orchard, geometry::platformPose(0.0, -1.5, 1.5, M_PI / 2), seed);
     const IsolationResult r =
         isolateTarget(v.cloud, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
                       Eigen::Vector2d(1.5, 0.0), IsolationConfig{});

@@ -9,11 +9,11 @@
 #include <iterator>
 #include <sstream>
 
+#include "dormant_tree_modeling/emulation/session_replay.h"
 #include "dormant_tree_modeling/evaluation/ground_truth.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/lms111/capture.h"
-#include "dormant_tree_modeling/lms111/session_replay.h"
 #include "temp_dir.h"
 
 namespace dormant_tree_modeling {

@@ -2,8 +2,8 @@
 
 #include <string>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/aerotech/ensemble_client.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 
 namespace dormant_tree_modeling {
 namespace aerotech {
@@ -27,7 +27,7 @@ struct StageConfig {
   EnsembleClientConfig controller;
   StageAxisConfig rotary{"X", "rotary_stage_joint", 1.0, 30.0, -100.0, 100.0};
   StageAxisConfig slide{"Y", "slide_joint", 1000.0, 0.05, 0.0, 0.6};
-  acquisition::StageGeometry geometry;
+  geometry::StageGeometry geometry;
   double joint_state_rate = 50.0;  ///< Hz
   bool home_on_start = true;
   double move_timeout_margin_s = 3.0;  ///< beyond the move's nominal duration

@@ -51,5 +51,15 @@ bool isRequestType(const std::string& type);
 /// the payload does not start with two words.
 std::pair<std::string, std::string> commandWords(const std::string& payload);
 
+/// @brief The telegram text in saved data: with framing the first complete telegram, without
+/// it the text itself with line ends trimmed. @throws Error PARSE_ERROR for an STX without ETX
+std::string telegramText(const std::string& data);
+
+/// @brief telegramText() of a file's content. @throws Error FILE_NOT_FOUND, PARSE_ERROR
+std::string readTelegramFile(const std::string& path);
+
+/// @brief readSessionText() of a file. @throws Error FILE_NOT_FOUND, PARSE_ERROR
+std::vector<CapturedTelegram> readSessionFile(const std::string& path);
+
 }  // namespace lms111
 }  // namespace dormant_tree_modeling

@@ -3,9 +3,9 @@
 #include <cstdint>
 #include <string>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/acquisition/view_plan.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/lms111_model.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 
@@ -18,7 +18,7 @@ struct DatasetOptions {
   std::uint64_t seed = 1;
   Lms111Config sensor;
   acquisition::ViewPlanConfig plan;
-  acquisition::StageGeometry geometry;
+  geometry::StageGeometry geometry;
   /// Initial-guess error of each platform position (what odometry or an operator would give):
   /// horizontal offset up to this radius (m), heading error up to this angle (deg).
   double guess_max_translation = 0.5;

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "dormant_tree_modeling/acquisition/range_image.h"
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/acquisition/view_plan.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/lms111_model.h"
 
 namespace dormant_tree_modeling {
@@ -29,7 +29,7 @@ struct SimulatedView {
 ///        number of threads
 /// @param threads 0 = all cores
 SimulatedView simulateView(const Lms111Model& model, const Eigen::Isometry3d& stage_pose,
-                           const acquisition::StageGeometry& geometry,
+                           const geometry::StageGeometry& geometry,
                            const acquisition::ViewPlanConfig& sweep, std::uint64_t seed,
                            int view_index, int threads = 0);
 

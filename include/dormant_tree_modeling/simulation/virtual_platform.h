@@ -5,9 +5,9 @@
 #include <mutex>
 #include <string>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
-#include "dormant_tree_modeling/aerotech/ensemble_server.h"
-#include "dormant_tree_modeling/lms111/emulator_server.h"
+#include "dormant_tree_modeling/emulation/ensemble_server.h"
+#include "dormant_tree_modeling/emulation/lms111_server.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/scene.h"
 
 namespace dormant_tree_modeling {
@@ -15,22 +15,22 @@ namespace simulation {
 
 /// @brief The scanning platform without hardware (architecture.md `virtual_platform`).
 struct VirtualPlatformOptions {
-  lms111::EmulatorServerOptions laser;  ///< ports of the LMS111 (CoLa-A, CoLa-B)
-  int stage_port = 8000;                ///< port of the Ensemble
-  double scan_frequency_hz = 25.0;      ///< the LMS111's power-up frequency (25 or 50)
-  double range_noise_sigma = 0.012;     ///< m
-  std::uint64_t seed = 1;               ///< sensor noise
+  emulation::LmsServerOptions laser;  ///< ports of the LMS111 (CoLa-A, CoLa-B)
+  int stage_port = 8000;              ///< port of the Ensemble
+  double scan_frequency_hz = 25.0;    ///< the LMS111's power-up frequency (25 or 50)
+  double range_noise_sigma = 0.012;   ///< m
+  std::uint64_t seed = 1;             ///< sensor noise
   /// The platform in the scene frame (platformPose); default: 1.5 m in front of the target
   /// tree, facing it, the laser at 1.5 m.
-  Eigen::Isometry3d platform = acquisition::platformPose(0.0, -1.5, 1.5, M_PI / 2);
+  Eigen::Isometry3d platform = geometry::platformPose(0.0, -1.5, 1.5, M_PI / 2);
   /// Mounting, as config/stage_controller.yaml: the platform frame at the slide's centre.
-  acquisition::StageGeometry geometry = [] {
-    acquisition::StageGeometry g;
+  geometry::StageGeometry geometry = [] {
+    geometry::StageGeometry g;
     g.platform_to_slide_base = Eigen::Vector3d(0.0, -0.3, 0.0);
     return g;
   }();
-  aerotech::EnsembleFaults stage_faults;
-  lms111::EmulatorFaults laser_faults;
+  emulation::EnsembleFaults stage_faults;
+  emulation::LmsFaults laser_faults;
 };
 
 /// @brief Serves an LMS111 and an Aerotech Ensemble (rotary stage X in deg, 600 mm slide Y in
@@ -58,9 +58,9 @@ class VirtualPlatform {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   };
   std::shared_ptr<PlatformState> platform_ = std::make_shared<PlatformState>();
-  std::shared_ptr<aerotech::EmulatedEnsemble> ensemble_;
-  std::unique_ptr<aerotech::EnsembleServer> stage_;
-  std::unique_ptr<lms111::EmulatorServer> laser_;
+  std::shared_ptr<emulation::EmulatedEnsemble> ensemble_;
+  std::unique_ptr<emulation::EnsembleServer> stage_;
+  std::unique_ptr<emulation::LmsServer> laser_;
 };
 
 }  // namespace simulation

@@ -10,7 +10,7 @@
 #include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
-namespace evaluation {
+namespace calibration {
 
 /// @brief One scan of the reference rig and what is known of it (RIG.json, the truth schema of
 /// docs/evaluation.md: the pipe as `trunk`, constant-diameter sections between pairs of
@@ -19,7 +19,7 @@ namespace evaluation {
 struct RigScan {
   std::string name;  ///< for messages and the calibration's sources
   modeling::Points points;
-  GroundTruth rig;
+  evaluation::GroundTruth rig;
   /// The views the scan was merged from, each with its pose into the rig's frame as
   /// `in_station` (optional): with them the silhouette growth of the registration's branch
   /// axes is measured on the rods, each station's side apart.
@@ -30,7 +30,7 @@ struct RigScan {
 /// into the rig's frame by its `true_pose` in views.json or, without one, by its pose in the
 /// folder's registration.json (register_views' output, copied there).
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR; INVALID_ARGUMENT when a view has no pose
-RigScan readRigViews(const std::string& dir, const GroundTruth& rig);
+RigScan readRigViews(const std::string& dir, const evaluation::GroundTruth& rig);
 
 /// @brief One measured pipe section or rod.
 struct RigSample {
@@ -76,5 +76,5 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
                                       const modeling::ModelerConfig& config,
                                       const std::string& name, const RigSearch& search = {});
 
-}  // namespace evaluation
+}  // namespace calibration
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/lms111/emulator_server.h"
+#include "dormant_tree_modeling/emulation/lms111_server.h"
 
 #include <boost/asio.hpp>
 #include <chrono>
@@ -8,7 +8,9 @@
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
+
+using namespace lms111;  // the emulator speaks the protocol the real driver speaks
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
@@ -21,7 +23,7 @@ constexpr auto TRICKLE_PAUSE = std::chrono::milliseconds(1);
 
 }  // namespace
 
-struct EmulatorServer::Impl {
+struct LmsServer::Impl {
   struct Session : std::enable_shared_from_this<Session> {
     Session(Impl& server, tcp::socket socket, Protocol protocol)
         : server(server),
@@ -34,7 +36,7 @@ struct EmulatorServer::Impl {
     tcp::socket socket;
     asio::steady_timer timer;  // trickle pauses
     std::unique_ptr<Framer> framer;
-    EmulatorSession state;
+    LmsSession state;
     std::array<char, 4096> buffer{};
     std::deque<std::string> queue;
     std::size_t offset = 0;  // bytes of queue.front() already written
@@ -111,7 +113,7 @@ struct EmulatorServer::Impl {
     }
   };
 
-  Impl(std::shared_ptr<EmulatedLms111> device, EmulatorServerOptions options)
+  Impl(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options)
       : device(std::move(device)), options(std::move(options)), scan_timer(io), restart_timer(io) {}
 
   double now() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
@@ -202,7 +204,7 @@ struct EmulatorServer::Impl {
         device->nextScan(std::chrono::duration<double>(next_scan - start).count());
     if (!telegram)
       return;
-    const EmulatorFaults& faults = device->faults();
+    const LmsFaults& faults = device->faults();
     ++scans_sent;
     std::string framed[2];
     auto all = sessions;
@@ -258,7 +260,7 @@ struct EmulatorServer::Impl {
 
   asio::io_context io;
   std::shared_ptr<EmulatedLms111> device;
-  EmulatorServerOptions options;
+  LmsServerOptions options;
   std::unique_ptr<tcp::acceptor> acceptors[2];
   int bound[2] = {-1, -1};
   std::list<std::shared_ptr<Session>> sessions;
@@ -271,8 +273,7 @@ struct EmulatorServer::Impl {
   std::atomic<std::size_t> sent{0}, accepted{0};
 };
 
-EmulatorServer::EmulatorServer(std::shared_ptr<EmulatedLms111> device,
-                               EmulatorServerOptions options)
+LmsServer::LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options)
     : impl_(std::make_unique<Impl>(std::move(device), std::move(options))) {
   if (!impl_->device)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the emulator server needs a device");
@@ -282,11 +283,11 @@ EmulatorServer::EmulatorServer(std::shared_ptr<EmulatedLms111> device,
   thread_ = std::thread([this] { impl_->io.run(); });
 }
 
-EmulatorServer::~EmulatorServer() {
+LmsServer::~LmsServer() {
   stop();
 }
 
-void EmulatorServer::stop() {
+void LmsServer::stop() {
   if (!thread_.joinable())
     return;
   asio::post(impl_->io, [this] {
@@ -298,21 +299,21 @@ void EmulatorServer::stop() {
   thread_.join();
 }
 
-int EmulatorServer::colaAPort() const {
+int LmsServer::colaAPort() const {
   return impl_->bound[0];
 }
 
-int EmulatorServer::colaBPort() const {
+int LmsServer::colaBPort() const {
   return impl_->bound[1];
 }
 
-std::size_t EmulatorServer::telegramsSent() const {
+std::size_t LmsServer::telegramsSent() const {
   return impl_->sent;
 }
 
-std::size_t EmulatorServer::connectionsAccepted() const {
+std::size_t LmsServer::connectionsAccepted() const {
   return impl_->accepted;
 }
 
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

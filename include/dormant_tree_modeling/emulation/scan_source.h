@@ -7,7 +7,7 @@
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
 
 /// @brief The beams of one scan as the device is configured: device angle convention
 /// (0 deg down, 90 deg ahead, 180 deg up), first and last beam inclusive.
@@ -44,10 +44,10 @@ class RecordedScanSource : public ScanSource {
  public:
   /// @param telegram a decoded telegram with a DIST1 channel
   /// @throws Error INVALID_ARGUMENT without a DIST1 channel or with an empty one
-  explicit RecordedScanSource(ScanTelegram telegram);
+  explicit RecordedScanSource(lms111::ScanTelegram telegram);
   /// @param telegrams decoded telegrams, each with a DIST1 channel
   /// @throws Error INVALID_ARGUMENT for none, or one without a usable DIST1 channel
-  explicit RecordedScanSource(std::vector<ScanTelegram> telegrams);
+  explicit RecordedScanSource(std::vector<lms111::ScanTelegram> telegrams);
 
   /// @brief Read a CoLa-A telegram from a text file (STX/ETX optional).
   /// @throws Error FILE_NOT_FOUND, PARSE_ERROR
@@ -56,15 +56,8 @@ class RecordedScanSource : public ScanSource {
   ScanContent scan(const ScanGeometry& geometry, double time_s, std::uint64_t index) override;
 
  private:
-  std::vector<ScanTelegram> telegrams_;
+  std::vector<lms111::ScanTelegram> telegrams_;
 };
 
-/// @brief The telegram text in saved data: with framing the first complete telegram, without
-/// it the text itself with line ends trimmed. @throws Error PARSE_ERROR for an STX without ETX
-std::string telegramText(const std::string& data);
-
-/// @brief telegramText() of a file's content. @throws Error FILE_NOT_FOUND, PARSE_ERROR
-std::string readTelegramFile(const std::string& path);
-
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -5,14 +5,14 @@
 #include <string>
 #include <thread>
 
-#include "dormant_tree_modeling/lms111/device_emulator.h"
+#include "dormant_tree_modeling/emulation/lms111_emulator.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
 
 /// @brief Where the emulator listens. A port of 0 picks a free one (see the accessors), -1
 /// disables that protocol.
-struct EmulatorServerOptions {
+struct LmsServerOptions {
   std::string address = "127.0.0.1";
   int cola_a_port = 2111;
   int cola_b_port = 2112;
@@ -20,14 +20,14 @@ struct EmulatorServerOptions {
 
 /// @brief Serves an EmulatedLms111 over TCP as the device does: CoLa-A and CoLa-B on their
 /// ports, any number of clients, scans streamed at the configured frequency to every client
-/// that switched the stream on, and the faults of EmulatorFaults. Runs its own I/O thread.
-class EmulatorServer {
+/// that switched the stream on, and the faults of LmsFaults. Runs its own I/O thread.
+class LmsServer {
  public:
   /// @throws Error IO_FAILURE when a port cannot be bound
-  EmulatorServer(std::shared_ptr<EmulatedLms111> device, EmulatorServerOptions options = {});
-  ~EmulatorServer();
-  EmulatorServer(const EmulatorServer&) = delete;
-  EmulatorServer& operator=(const EmulatorServer&) = delete;
+  LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options = {});
+  ~LmsServer();
+  LmsServer(const LmsServer&) = delete;
+  LmsServer& operator=(const LmsServer&) = delete;
 
   /// @brief Bound CoLa-A / CoLa-B port (-1 when disabled).
   int colaAPort() const;
@@ -45,5 +45,5 @@ class EmulatorServer {
   std::thread thread_;
 };
 
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

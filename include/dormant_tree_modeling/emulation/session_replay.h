@@ -4,23 +4,23 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/emulation/lms111_emulator.h"
 #include "dormant_tree_modeling/lms111/capture.h"
-#include "dormant_tree_modeling/lms111/device_emulator.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
 
 /// @brief A recorded real CoLa-B session taken apart for replay: each host request with the
 /// device's reply, the events, and the scans.
 struct RecordedSessionParts {
   RecordedReplies replies;
-  std::vector<ScanTelegram> scans;  ///< the recorded `sSN LMDscandata` telegrams, decoded
-  std::size_t requests = 0;         ///< host requests in the recording
+  std::vector<lms111::ScanTelegram> scans;  ///< the recorded `sSN LMDscandata` telegrams, decoded
+  std::size_t requests = 0;                 ///< host requests in the recording
 };
 
 /// @brief Takes a session apart (readSessionText's telegrams).
 /// @throws Error PARSE_ERROR when the session holds no scan, or a recorded scan does not decode
-RecordedSessionParts splitRecordedSession(const std::vector<CapturedTelegram>& session);
+RecordedSessionParts splitRecordedSession(const std::vector<lms111::CapturedTelegram>& session);
 
 /// @brief A test device that replays a real session: an EmulatedLms111 (strict about every
 /// request's layout, streaming at the configured frequency with advancing counters and clock)
@@ -30,12 +30,9 @@ RecordedSessionParts splitRecordedSession(const std::vector<CapturedTelegram>& s
 /// recorded serial number and clock start.
 /// @param config identity and timing; its serial number and clock start are the recording's
 /// @throws Error as splitRecordedSession
-std::shared_ptr<EmulatedLms111> makeSessionReplay(const std::vector<CapturedTelegram>& session,
-                                                  EmulatorConfig config = {},
-                                                  EmulatorFaults faults = {});
+std::shared_ptr<EmulatedLms111> makeSessionReplay(
+    const std::vector<lms111::CapturedTelegram>& session, LmsEmulatorConfig config = {},
+    LmsFaults faults = {});
 
-/// @brief readSessionText() of a file. @throws Error FILE_NOT_FOUND, PARSE_ERROR
-std::vector<CapturedTelegram> readSessionFile(const std::string& path);
-
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

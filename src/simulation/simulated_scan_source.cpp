@@ -1,17 +1,17 @@
-#include "dormant_tree_modeling/lms111/simulated_scan_source.h"
+#include "dormant_tree_modeling/simulation/simulated_scan_source.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace simulation {
 
-SimulatedScanSource::SimulatedScanSource(const simulation::Scene& scene, PoseFunction pose,
-                                         simulation::Lms111Config sensor, std::uint64_t seed)
-    : caster_(std::make_unique<simulation::RayCaster>(scene)),
+SimulatedScanSource::SimulatedScanSource(const Scene& scene, PoseFunction pose, Lms111Config sensor,
+                                         std::uint64_t seed)
+    : caster_(std::make_unique<RayCaster>(scene)),
       pose_(std::move(pose)),
       sensor_(sensor),
       seed_(seed) {
@@ -19,17 +19,17 @@ SimulatedScanSource::SimulatedScanSource(const simulation::Scene& scene, PoseFun
     throw Error(ErrorCode::INVALID_ARGUMENT, "a simulated scan source needs a pose function");
 }
 
-ScanContent SimulatedScanSource::scan(const ScanGeometry& geometry, double time_s,
-                                      std::uint64_t index) {
-  simulation::Lms111Config config = sensor_;
+emulation::ScanContent SimulatedScanSource::scan(const emulation::ScanGeometry& geometry,
+                                                 double time_s, std::uint64_t index) {
+  Lms111Config config = sensor_;
   config.angular_resolution_deg = geometry.step_deg;
   config.scan_frequency_hz = geometry.scan_frequency_hz;
   config.start_angle_deg = geometry.start_angle_deg;
   config.stop_angle_deg = geometry.start_angle_deg + geometry.count * geometry.step_deg;
-  const simulation::Lms111Model model(*caster_, config);
+  const Lms111Model model(*caster_, config);
   Rng rng = Rng::derive(seed_, 11, index);
-  const simulation::ScanLine line = model.scanLine(pose_(time_s), rng);
-  ScanContent out;
+  const ScanLine line = model.scanLine(pose_(time_s), rng);
+  emulation::ScanContent out;
   out.distances_mm.assign(geometry.count, 0);
   out.rssi.assign(geometry.count, 0);
   const int n = std::min<int>(geometry.count, static_cast<int>(line.ranges.size()));
@@ -43,10 +43,10 @@ ScanContent SimulatedScanSource::scan(const ScanGeometry& geometry, double time_
 
 Eigen::Isometry3d SimulatedScanSource::frontView(double distance, double height) {
   // The platform's x axis points at the tree: from y = -distance that is the scene's +y.
-  const Eigen::Isometry3d platform = acquisition::platformPose(0.0, -distance, height, M_PI / 2);
-  const acquisition::StageGeometry geometry;
-  return acquisition::laserPose(acquisition::stagePose(platform, geometry, 0.0), geometry, 0.0);
+  const Eigen::Isometry3d platform = geometry::platformPose(0.0, -distance, height, M_PI / 2);
+  const geometry::StageGeometry geometry;
+  return geometry::laserPose(geometry::stagePose(platform, geometry, 0.0), geometry, 0.0);
 }
 
-}  // namespace lms111
+}  // namespace simulation
 }  // namespace dormant_tree_modeling

@@ -4,10 +4,10 @@
 #include <string>
 #include <thread>
 
-#include "dormant_tree_modeling/aerotech/ensemble_emulator.h"
+#include "dormant_tree_modeling/emulation/ensemble_emulator.h"
 
 namespace dormant_tree_modeling {
-namespace aerotech {
+namespace emulation {
 
 /// @brief Serves an EmulatedEnsemble on TCP as the controller's ASCII socket does: one line a
 /// command, one reply line each, in order, blocking replies (HOME, WAIT MODE MOVEDONE) sent
@@ -35,5 +35,5 @@ class EnsembleServer {
   std::thread thread_;
 };
 
-}  // namespace aerotech
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/aerotech/ensemble_server.h"
+#include "dormant_tree_modeling/emulation/ensemble_server.h"
 
 #include <atomic>
 #include <boost/asio.hpp>
@@ -10,7 +10,9 @@
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
-namespace aerotech {
+namespace emulation {
+
+using namespace aerotech;  // the emulator speaks the protocol the real client speaks
 
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
@@ -198,5 +200,5 @@ std::size_t EnsembleServer::connectionsAccepted() const {
   return impl_->accepted;
 }
 
-}  // namespace aerotech
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

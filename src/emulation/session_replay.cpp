@@ -1,10 +1,12 @@
-#include "dormant_tree_modeling/lms111/session_replay.h"
+#include "dormant_tree_modeling/emulation/session_replay.h"
 
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/lms111/scan_source.h"
+#include "dormant_tree_modeling/emulation/scan_source.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
+
+using namespace lms111;  // the emulator speaks the protocol the real driver speaks
 
 namespace {
 
@@ -53,7 +55,7 @@ RecordedSessionParts splitRecordedSession(const std::vector<CapturedTelegram>& s
 }
 
 std::shared_ptr<EmulatedLms111> makeSessionReplay(const std::vector<CapturedTelegram>& session,
-                                                  EmulatorConfig config, EmulatorFaults faults) {
+                                                  LmsEmulatorConfig config, LmsFaults faults) {
   RecordedSessionParts parts = splitRecordedSession(session);
   config.serial_number = parts.scans.front().serial_number;
   config.clock_start_us = parts.scans.front().time_since_startup_us;
@@ -63,9 +65,5 @@ std::shared_ptr<EmulatedLms111> makeSessionReplay(const std::vector<CapturedTele
   return device;
 }
 
-std::vector<CapturedTelegram> readSessionFile(const std::string& path) {
-  return readSessionText(readRecording(path, "session file"));
-}
-
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -1,11 +1,13 @@
-#include "dormant_tree_modeling/lms111/device_emulator.h"
+#include "dormant_tree_modeling/emulation/lms111_emulator.h"
 
 #include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
+
+using namespace lms111;  // the emulator speaks the protocol the real driver speaks
 
 namespace {
 
@@ -84,7 +86,7 @@ DataOutputConfig readDataOutputConfig(FieldReader& r) {
 
 }  // namespace
 
-void EmulatorFaults::addSfa(const std::string& spec) {
+void LmsFaults::addSfa(const std::string& spec) {
   const auto a = spec.find(':');
   if (a == std::string::npos || a == 0) {
     throw Error(ErrorCode::INVALID_ARGUMENT,
@@ -106,8 +108,8 @@ void EmulatorFaults::addSfa(const std::string& spec) {
   }
 }
 
-EmulatedLms111::EmulatedLms111(EmulatorConfig config, std::shared_ptr<ScanSource> source,
-                               EmulatorFaults faults)
+EmulatedLms111::EmulatedLms111(LmsEmulatorConfig config, std::shared_ptr<ScanSource> source,
+                               LmsFaults faults)
     : config_(std::move(config)), source_(std::move(source)), faults_(std::move(faults)) {
   if (!source_)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the emulated LMS111 needs a scan source");
@@ -141,7 +143,7 @@ int EmulatedLms111::state(double now_s) const {
   return now_s < ready_at_s_ ? 5 : STATE_READY_FOR_MEASUREMENT;  // in preparation / ready
 }
 
-std::string EmulatedLms111::reply(const EmulatorSession& session, const std::string& type,
+std::string EmulatedLms111::reply(const LmsSession& session, const std::string& type,
                                   const std::string& name,
                                   const std::function<void(FieldWriter&)>& fields) const {
   const auto w = makeWriter(session.protocol);
@@ -157,12 +159,12 @@ std::string EmulatedLms111::reply(const EmulatorSession& session, const std::str
   return payload;
 }
 
-std::string EmulatedLms111::sfa(const EmulatorSession& session, int code) const {
+std::string EmulatedLms111::sfa(const LmsSession& session, int code) const {
   return sfaReply(session.protocol, code);
 }
 
-std::vector<std::string> EmulatedLms111::handle(const std::string& payload,
-                                                EmulatorSession& session, double now_s) {
+std::vector<std::string> EmulatedLms111::handle(const std::string& payload, LmsSession& session,
+                                                double now_s) {
   const auto reader = makeReader(session.protocol, payload);
   std::string type, name;
   try {
@@ -186,7 +188,7 @@ std::optional<std::string> EmulatedLms111::nextEvent(Protocol protocol) {
 
 std::string EmulatedLms111::answer(const std::string& payload, const std::string& type,
                                    const std::string& name, FieldReader& reader,
-                                   EmulatorSession& session, double now_s) {
+                                   LmsSession& session, double now_s) {
   const bool recorded = recording_ && session.protocol == Protocol::COLA_B;
   if (recorded) {
     const auto size = recording_->request_bytes.find(type + " " + name);
@@ -216,7 +218,7 @@ std::string EmulatedLms111::answer(const std::string& payload, const std::string
 }
 
 std::string EmulatedLms111::dispatch(const std::string& type, const std::string& name,
-                                     FieldReader& r, EmulatorSession& session, double now_s) {
+                                     FieldReader& r, LmsSession& session, double now_s) {
   auto requireLevel = [&]() {
     if (session.access_level < AUTHORISED_CLIENT_LEVEL)
       throw SfaReply{SFA_ACCESS_DENIED};
@@ -432,5 +434,5 @@ std::optional<ScanTelegram> EmulatedLms111::nextScan(double now_s) {
   return s;
 }
 
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/evaluation/rig_calibration.h"
+#include "dormant_tree_modeling/calibration/rig_calibration.h"
 
 #include <nlohmann/json.hpp>
 
@@ -20,7 +20,7 @@
 #include "dormant_tree_modeling/registration/view_folder.h"
 
 namespace dormant_tree_modeling {
-namespace evaluation {
+namespace calibration {
 
 namespace {
 
@@ -52,7 +52,7 @@ std::string mm(double m) {
 }
 
 /// The pipe's constant-diameter sections long enough to measure, margins taken off.
-std::vector<Section> pipeSections(const Polyline& pipe, const RigSearch& search,
+std::vector<Section> pipeSections(const evaluation::Polyline& pipe, const RigSearch& search,
                                   double slice_height) {
   std::vector<Section> out;
   for (std::size_t k = 0; k + 1 < pipe.points.size() && k + 1 < pipe.diameters.size(); ++k) {
@@ -86,7 +86,7 @@ void recentre(RigScan& scan) {
   const Eigen::Vector3d origin = scan.rig.trunk.points.front();
   for (auto& p : scan.points)
     p -= origin;
-  auto move = [&](Polyline& line) {
+  auto move = [&](evaluation::Polyline& line) {
     for (auto& p : line.points)
       p -= origin;
   };
@@ -112,11 +112,11 @@ std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerC
                 "rig scan " + scan.name + ": " + e.what());
   }
   *sigma = result.noise_sigma;
-  MatchBounds bounds;
+  evaluation::MatchBounds bounds;
   bounds.min_distance = search.axis_tolerance_m;
   bounds.max_arc_length = MAX_ROD_ARC_M;
   bounds.max_angle_deg = MAX_ROD_ANGLE_DEG;
-  const TreeScore score = evaluate(result.model, scan.rig, bounds);
+  const evaluation::TreeScore score = evaluation::evaluate(result.model, scan.rig, bounds);
   std::vector<RigSample> out;
   for (const auto& m : score.matches) {
     RigSample s;
@@ -317,20 +317,21 @@ void checkCoverage(const std::vector<RigSample>& samples, bool trunk, const char
 }
 
 /// The rod whose axis a silhouette sample lies on, or -1.
-int rodOf(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const GroundTruth& rig,
+int rodOf(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const evaluation::GroundTruth& rig,
           const RigSearch& search) {
   const double min_cos = std::cos(search.max_silhouette_angle_deg * M_PI / 180.0);
   for (std::size_t k = 0; k < rig.primary_branches.size(); ++k) {
-    const PolylinePoint q = closestPoint(rig.primary_branches[k], p);
+    const evaluation::PolylinePoint q = evaluation::closestPoint(rig.primary_branches[k], p);
     if (q.distance < search.silhouette_reach_m && std::abs(q.direction.dot(dir)) >= min_cos)
       return static_cast<int>(k);
   }
   return -1;
 }
 
-bool nearARod(const Eigen::Vector3d& p, const GroundTruth& rig) {
+bool nearARod(const Eigen::Vector3d& p, const evaluation::GroundTruth& rig) {
   for (const auto& rod : rig.primary_branches) {
-    if (closestPoint(rod, p).distance < 0.5 * rod.diameters.front() + SILHOUETTE_NEAR_ROD_M)
+    if (evaluation::closestPoint(rod, p).distance <
+        0.5 * rod.diameters.front() + SILHOUETTE_NEAR_ROD_M)
       return true;
   }
   return false;
@@ -384,12 +385,12 @@ struct AxisSampleOnRod {
 };
 
 std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& stations,
-                                           const std::vector<GroundTruth>& rigs,
+                                           const std::vector<evaluation::GroundTruth>& rigs,
                                            const RigSearch& search,
                                            const registration::AxisConfig& axes_config) {
   std::vector<AxisSampleOnRod> out;
   for (const auto& s : stations) {
-    const GroundTruth& rig = rigs[s.rig];
+    const evaluation::GroundTruth& rig = rigs[s.rig];
     const auto axes = registration::estimateAxes(s.pts, s.dirs, s.ranges, s.centres, axes_config);
     for (std::size_t i = 0; i < axes.size(); ++i) {
       const int k = rodOf(axes.points[i], axes.directions[i], rig, search);
@@ -448,8 +449,9 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOn
 /// rods' depth: the footprint's wings widen the silhouette but carry the near surface's range,
 /// so the depth model wants less than the whole widening. Bisection on the median depth error,
 /// which falls as the share grows (a smaller radius puts the axis nearer the surface).
-double depthShare(const std::vector<StationPoints>& stations, const std::vector<GroundTruth>& rigs,
-                  const RigSearch& search, const modeling::SensorCalibration::Silhouette& growth) {
+double depthShare(const std::vector<StationPoints>& stations,
+                  const std::vector<evaluation::GroundTruth>& rigs, const RigSearch& search,
+                  const modeling::SensorCalibration::Silhouette& growth) {
   auto error = [&](double share) {
     registration::AxisConfig c;
     c.silhouette_growth_m = share * growth.growth_m;
@@ -469,7 +471,7 @@ double depthShare(const std::vector<StationPoints>& stations, const std::vector<
 
 }  // namespace
 
-RigScan readRigViews(const std::string& dir, const GroundTruth& rig) {
+RigScan readRigViews(const std::string& dir, const evaluation::GroundTruth& rig) {
   registration::ViewFolderOptions o;
   o.crop_radius = 0.0;
   o.use_guesses = false;
@@ -524,7 +526,7 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   RigCalibrationResult result;
   std::vector<double> sigmas;
   std::vector<StationPoints> stations;
-  std::vector<GroundTruth> rigs;
+  std::vector<evaluation::GroundTruth> rigs;
   bool with_views = false;
   for (RigScan scan : scans) {
     if (scan.points.empty())
@@ -579,5 +581,5 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   return result;
 }
 
-}  // namespace evaluation
+}  // namespace calibration
 }  // namespace dormant_tree_modeling

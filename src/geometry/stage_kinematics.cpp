@@ -1,7 +1,7 @@
-#include "dormant_tree_modeling/acquisition/stage_kinematics.h"
+#include "dormant_tree_modeling/geometry/stage_kinematics.h"
 
 namespace dormant_tree_modeling {
-namespace acquisition {
+namespace geometry {
 
 Eigen::Isometry3d platformPose(double x, double y, double z, double yaw) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -26,5 +26,5 @@ Eigen::Isometry3d laserPose(const Eigen::Isometry3d& stage_pose, const StageGeom
   return pose;
 }
 
-}  // namespace acquisition
+}  // namespace geometry
 }  // namespace dormant_tree_modeling

@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace dormant_tree_modeling {
-namespace aerotech {
+namespace emulation {
 
 /// @brief One emulated axis: its limits and motion capability, in controller units (deg for a
 /// rotary stage, mm for a linear one) and seconds.
@@ -89,5 +89,5 @@ class EmulatedEnsemble {
   mutable std::mutex mutex_;
 };
 
-}  // namespace aerotech
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/aerotech/ensemble_emulator.h"
+#include "dormant_tree_modeling/emulation/ensemble_emulator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,9 @@
 #include "dormant_tree_modeling/common/error.h"
 
 namespace dormant_tree_modeling {
-namespace aerotech {
+namespace emulation {
+
+using namespace aerotech;  // the emulator speaks the protocol the real client speaks
 
 namespace {
 
@@ -348,5 +350,5 @@ double EmulatedEnsemble::position(const std::string& axis, double now_s) const {
   return positionAt(*a, now_s);
 }
 
-}  // namespace aerotech
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -3,7 +3,7 @@
 #include <Eigen/Geometry>
 
 namespace dormant_tree_modeling {
-namespace acquisition {
+namespace geometry {
 
 /// @brief Mounting of the slide and rotary stage on the platform (tf chain of
 /// architecture.md: platform -> slide_base -> slide_carriage -> rotary_stage -> laser).
@@ -30,5 +30,5 @@ Eigen::Isometry3d stagePose(const Eigen::Isometry3d& platform, const StageGeomet
 Eigen::Isometry3d laserPose(const Eigen::Isometry3d& stage_pose, const StageGeometry& geometry,
                             double theta);
 
-}  // namespace acquisition
+}  // namespace geometry
 }  // namespace dormant_tree_modeling

@@ -1,4 +1,4 @@
-#include "dormant_tree_modeling/lms111/scan_source.h"
+#include "dormant_tree_modeling/emulation/scan_source.h"
 
 #include <cmath>
 #include <fstream>
@@ -9,26 +9,9 @@
 #include "dormant_tree_modeling/lms111/cola.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
 
-std::string telegramText(const std::string& data) {
-  if (data.find(STX) != std::string::npos) {
-    ColaAFramer framer;
-    framer.feed(data);
-    const auto telegram = framer.next();
-    if (!telegram)
-      throw Error(ErrorCode::PARSE_ERROR, "an STX without its ETX");
-    return *telegram;
-  }
-  std::string text = data;
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
-    text.pop_back();
-  return text;
-}
-
-std::string readTelegramFile(const std::string& path) {
-  return telegramText(readRecording(path, "telegram file"));
-}
+using namespace lms111;  // the emulator speaks the protocol the real driver speaks
 
 RecordedScanSource::RecordedScanSource(ScanTelegram telegram)
     : RecordedScanSource(std::vector<ScanTelegram>{std::move(telegram)}) {}
@@ -72,5 +55,5 @@ ScanContent RecordedScanSource::scan(const ScanGeometry& geometry, double, std::
   return out;
 }
 
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling

@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "dormant_tree_modeling/emulation/scan_source.h"
 #include "dormant_tree_modeling/lms111/cola.h"
 #include "dormant_tree_modeling/lms111/cola_fields.h"
-#include "dormant_tree_modeling/lms111/scan_source.h"
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
 
 namespace dormant_tree_modeling {
-namespace lms111 {
+namespace emulation {
 
 /// @brief Scan configuration as the device holds it, in the device's units.
 struct DeviceScanConfig {
@@ -39,7 +39,7 @@ struct DataOutputConfig {
 
 /// @brief Failures an emulated device can be told to show, for tests. Counts refer to scan
 /// telegrams sent since the emulator (re)started; 0 switches a fault off.
-struct EmulatorFaults {
+struct LmsFaults {
   std::size_t drop_after = 0;   ///< close every connection once after this many telegrams
   std::size_t stall_after = 0;  ///< then send nothing (and answer nothing) for stall_seconds
   double stall_seconds = 2.0;
@@ -60,7 +60,7 @@ struct EmulatorFaults {
 };
 
 /// @brief Identity and timing of an emulated device.
-struct EmulatorConfig {
+struct LmsEmulatorConfig {
   std::uint32_t serial_number = 0x00A037B9;
   std::string device_name = "LMS111-10100";
   std::string firmware_version = "V1.10";
@@ -82,8 +82,8 @@ struct RecordedReplies {
 };
 
 /// @brief One client connection's view of the device.
-struct EmulatorSession {
-  Protocol protocol = Protocol::COLA_A;
+struct LmsSession {
+  lms111::Protocol protocol = lms111::Protocol::COLA_A;
   int access_level = 0;
   bool streaming = false;
 };
@@ -97,14 +97,13 @@ struct EmulatorSession {
 class EmulatedLms111 {
  public:
   /// @param source scan content; shared with the caller
-  EmulatedLms111(EmulatorConfig config, std::shared_ptr<ScanSource> source,
-                 EmulatorFaults faults = {});
+  EmulatedLms111(LmsEmulatorConfig config, std::shared_ptr<ScanSource> source,
+                 LmsFaults faults = {});
 
   /// @brief Replies to one request payload: the reply, preceded by a recorded event when a
   /// recording with events is set.
   /// @param now_s seconds since the emulator started (steady clock)
-  std::vector<std::string> handle(const std::string& payload, EmulatorSession& session,
-                                  double now_s);
+  std::vector<std::string> handle(const std::string& payload, LmsSession& session, double now_s);
 
   /// @brief `STlms` state at a time.
   int state(double now_s) const;
@@ -112,7 +111,7 @@ class EmulatedLms111 {
   double scanPeriod() const { return 100.0 / active_.frequency; }
   /// @brief The next scan telegram, its first ray at now_s; advances the counters. Empty
   /// when the device is not ready, or the output interval skips this scan.
-  std::optional<ScanTelegram> nextScan(double now_s);
+  std::optional<lms111::ScanTelegram> nextScan(double now_s);
   /// @brief Device clock (µs since power-up, wrapping at 2^32) at a time.
   std::uint32_t clockUs(double now_s) const;
   /// @brief Reboot: configuration back to the power-up values, counters and clock restart.
@@ -124,25 +123,24 @@ class EmulatedLms111 {
   /// preceded by the next recorded event, as a device does whose events a client subscribed.
   void setRecording(RecordedReplies recording) { recording_ = std::move(recording); }
   /// @brief The next recorded event for a connection of that protocol (CoLa-B only), cycling.
-  std::optional<std::string> nextEvent(Protocol protocol);
+  std::optional<std::string> nextEvent(lms111::Protocol protocol);
 
-  const EmulatorFaults& faults() const { return faults_; }
+  const LmsFaults& faults() const { return faults_; }
   const DeviceScanConfig& scanConfig() const { return active_; }
   const DataOutputConfig& outputConfig() const { return output_; }
 
  private:
-  std::string reply(const EmulatorSession& session, const std::string& type,
-                    const std::string& name,
-                    const std::function<void(FieldWriter&)>& fields = {}) const;
-  std::string sfa(const EmulatorSession& session, int code) const;
+  std::string reply(const LmsSession& session, const std::string& type, const std::string& name,
+                    const std::function<void(lms111::FieldWriter&)>& fields = {}) const;
+  std::string sfa(const LmsSession& session, int code) const;
   std::string answer(const std::string& payload, const std::string& type, const std::string& name,
-                     FieldReader& args, EmulatorSession& session, double now_s);
-  std::string dispatch(const std::string& type, const std::string& name, FieldReader& args,
-                       EmulatorSession& session, double now_s);
+                     lms111::FieldReader& args, LmsSession& session, double now_s);
+  std::string dispatch(const std::string& type, const std::string& name, lms111::FieldReader& args,
+                       LmsSession& session, double now_s);
 
-  EmulatorConfig config_;
+  LmsEmulatorConfig config_;
   std::shared_ptr<ScanSource> source_;
-  EmulatorFaults faults_;
+  LmsFaults faults_;
   DeviceScanConfig active_, pending_;
   DataOutputConfig output_;
   bool measuring_ = true;
@@ -154,5 +152,5 @@ class EmulatedLms111 {
   std::size_t next_event_ = 0;
 };
 
-}  // namespace lms111
+}  // namespace emulation
 }  // namespace dormant_tree_modeling
