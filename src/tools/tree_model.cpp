@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
         std::cerr << "  " << t.first << ": " << t.second << " s\n";
       std::map<std::string, int> reasons;
       for (const auto& r : result.rejected_branches)
-        ++reasons[r.reason];
+        ++reasons[r.text()];
       std::cerr << "  branch candidates turned down:";
       for (const auto& [reason, n] : reasons)
         std::cerr << " " << reason << " " << n << ";";

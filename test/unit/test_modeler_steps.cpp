@@ -437,7 +437,7 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_NEAR(branches[0].attachment.z(), 0.8, 0.03);
   std::map<std::string, int> reasons;
   for (const auto& r : rejected)
-    ++reasons[r.reason];
+    ++reasons[r.text()];
   EXPECT_EQ(reasons["a wire"], 2);
   EXPECT_EQ(reasons["too short"], 1);
   EXPECT_EQ(reasons["too low"], 1);
@@ -458,7 +458,7 @@ TEST(BranchModel, OppositeThinBranchesAcrossTheRowAreNoWire) {
   const auto wires = [](const std::vector<RejectedBranch>& rejected) {
     int n = 0;
     for (const auto& r : rejected)
-      n += r.reason == "a wire";
+      n += r.reason == BranchRejection::WIRE;
     return n;
   };
   std::vector<RejectedBranch> rejected;
@@ -516,14 +516,14 @@ TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   std::vector<RejectedBranch> rejected;
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 2u);
   for (const auto& r : rejected)
-    EXPECT_EQ(r.reason.find("budget"), std::string::npos) << r.reason;
+    EXPECT_FALSE(r.budget_spent) << r.text();
 
   config.branch_search_budget = 0;
   rejected.clear();
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 1u);
   int unsearched = 0;
   for (const auto& r : rejected)
-    unsearched += r.reason.find("(search budget spent)") != std::string::npos;
+    unsearched += r.budget_spent;
   EXPECT_EQ(unsearched, 1) << "the lost branch is reported";
 }
 
@@ -546,7 +546,7 @@ TEST(BranchModel, ADetectionWithFewPointsForItsTreeIsDropped) {
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 4u);
   int dropped = 0;
   for (const auto& r : rejected)
-    dropped += r.reason == "few points for this tree";
+    dropped += r.reason == BranchRejection::FEW_POINTS_FOR_THIS_TREE;
   EXPECT_EQ(dropped, 1);
   config.branch_min_relative_points = 0.0;
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config).size(), 5u);

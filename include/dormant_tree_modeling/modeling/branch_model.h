@@ -23,16 +23,40 @@ struct BranchFit {
   bool reaches_surface = true;
 };
 
+/// @brief Why a branch candidate was turned down.
+enum class BranchRejection {
+  TOO_FEW_POINTS,            ///< fewer than branch_min_points within branch_fit_length
+  NO_FIT,                    ///< no cylinder fits its near part
+  OFF_ITS_RAY,               ///< parted along a ray, its fit leaves that ray
+  NOT_RADIAL,                ///< the fit does not point away from the trunk
+  POINTS_DOWN,               ///< the fit dives below branch_min_elevation
+  THICKER_THAN_THE_TRUNK,    ///< wider than branch_max_diameter_ratio of its trunk segment
+  MISSES_THE_TRUNK,          ///< the fit's axis passes the trunk axis beyond branch_axis_gap
+  NOT_AT_THE_SURFACE,        ///< its points start away from the trunk with air between
+  TOO_SHORT,                 ///< shorter than branch_min_length
+  TOO_LOW,                   ///< attached below branch_min_height
+  WIRE,                      ///< a trellis wire's points (taken out of the candidate)
+  DUPLICATE,                 ///< a second detection of a branch already kept
+  FEW_POINTS_FOR_THIS_TREE,  ///< under branch_min_relative_points of the tree's median
+  REMAINDER_NOT_SEARCHED,    ///< what an extraction left, with the search budget spent
+};
+
+/// @brief The words for a reason, as logs and `tree_model -v` print them ("too few points",
+/// "no fit", "off its ray", "not radial", "points down", "thicker than the trunk", "misses the
+/// trunk", "not at the surface", "too short", "too low", "a wire", "duplicate", "few points
+/// for this tree", "remainder not searched").
+const char* branchRejectionText(BranchRejection reason);
+
 /// @brief A branch candidate that was turned down, and why (for diagnostics).
 struct RejectedBranch {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the candidate's points
   int points = 0;
-  std::string reason;  ///< "too few points", "no fit", "off its ray", "not radial", "points
-                       ///< down", "thicker than the trunk", "misses the trunk", "not at the
-                       ///< surface", "too short", "too low", "a wire" (the wire's points),
-                       ///< "duplicate"; with " (search budget spent)" when it was not split
-                       ///< for lack of budget, and "remainder not searched (search budget
-                       ///< spent)" for what an extraction left
+  BranchRejection reason = BranchRejection::NO_FIT;
+  /// It could have been split (or searched) but the search budget was spent.
+  bool budget_spent = false;
+
+  /// @brief The reason's words, with " (search budget spent)" when budget_spent.
+  std::string text() const;
 };
 
 /// @brief Whether two detections are one branch (a gap in its returns split it into two

@@ -1,0 +1,490 @@
+#include "branch_search.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "dormant_tree_modeling/modeling/branch_rays.h"
+#include "dormant_tree_modeling/modeling/noise_band.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace detail {
+
+namespace {
+
+constexpr double DEG = M_PI / 180.0;
+constexpr double MIN_BRANCH_RADIUS = 0.002;  // m
+constexpr double SURFACE_CONTACT = 0.05;     // m beyond inner_gap that still touches the trunk
+// The paper's search: the RANSAC axis strays up to this far from the guess, and a branch may be
+// as wide as this.
+constexpr double PAPER_MAX_AXIS_DEVIATION = 35.0 * DEG;
+constexpr double PAPER_MAX_BRANCH_RADIUS = 0.3;  // m
+// Ours: the axis stays closer to the guess, and a branch no wider than its trunk segment.
+constexpr double MAX_AXIS_DEVIATION = 30.0 * DEG;
+constexpr int AXIS_CANDIDATES = 8;
+// A fit wider across the trunk than along it by this share of its length is judged by its
+// azimuth (sideways or not); a near-vertical fit is not.
+constexpr double MIN_ACROSS_SHARE = 0.3;
+// A candidate this many times branch_min_points and more may be split when it fits no branch;
+// a remainder this many times branch_min_points and more is searched again.
+constexpr int SPLIT_MIN_SIZE = 4;
+constexpr int REMAINDER_MIN_SIZE = 2;
+// A candidate of this many times branch_min_points whose fit is too short is split and retried.
+constexpr int SHORT_SPLIT = 12;
+constexpr int HALVES_ITERATIONS = 20;  // of the k-means that halves a fused candidate
+// A found line's points: within its radius, the noise band and this margin of its axis.
+constexpr double EXTRACTION_MARGIN = 0.005;  // m
+constexpr double STEEP_ELONGATION = 16.0;    // variance ratio (4:1 in length) of a directed cluster
+// A candidate parted along a ray is a branch along it: its fit stays within this of the ray.
+constexpr double RAY_AGREEMENT = 20.0 * DEG;
+// Its points: within the noise band (at least RAY_MIN_BAND) plus RAY_TUBE_RADIUS (a thin
+// branch's radius with a margin) of the ray.
+constexpr double RAY_MIN_BAND = 0.01;     // m
+constexpr double RAY_TUBE_RADIUS = 0.01;  // m
+// A fit cut off from the trunk surface (branch_keep_cut_off) needs returns on its way back to
+// the trunk: at each step this share of the returns around the fit's centre, at least
+// CUT_FILL_MIN_POINTS.
+constexpr double CUT_WALK_REACH = 1.0;  // m, beyond any fit's way back
+constexpr double CUT_FILL_SHARE = 0.2;
+constexpr int CUT_FILL_MIN_POINTS = 3;
+// Seeds: per candidate, from the modeler's seed and a running stream.
+constexpr std::uint64_t HALVES_SEED_FACTOR = 7757ULL;
+constexpr std::uint64_t FIT_SEED_FACTOR = 15485863ULL;
+
+// A trellis wire: thin, near level, and seen again beyond the trunk on its line.
+constexpr double MAX_WIRE_RADIUS = 0.004;  // m
+constexpr double MAX_WIRE_TILT = 15.0 * DEG;
+constexpr double MAX_WIRE_CROSSING = 15.0 * DEG;  // from the row's wires
+constexpr double WIRE_STEP = 0.02;                // m along the far side
+constexpr double WIRE_FAR_FROM = 0.05;            // m past the trunk surface
+constexpr double WIRE_FAR_TO = 0.4;               // m past the trunk surface
+constexpr double WIRE_TOLERANCE = 0.008;          // m plus the noise, around each step
+constexpr double WIRE_OCCUPIED_SHARE = 0.8;       // of the steps that hold a return
+
+double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+}
+
+/// Closest points between two lines p + t u and q + s v: returns the distance between the
+/// lines and, in on_second, the point on the second.
+double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& q,
+               const Eigen::Vector3d& v, Eigen::Vector3d* on_second) {
+  const Eigen::Vector3d w = p - q;
+  const double a = u.dot(u), b = u.dot(v), c = v.dot(v), d = u.dot(w), e = v.dot(w);
+  const double den = a * c - b * b;
+  double t = 0.0, s = 0.0;
+  if (std::abs(den) > 1e-12) {
+    t = (b * e - c * d) / den;
+    s = (a * e - b * d) / den;
+  } else {
+    s = e / c;
+  }
+  const Eigen::Vector3d x = p + t * u, y = q + s * v;
+  if (on_second)
+    *on_second = y;
+  return (x - y).norm();
+}
+
+/// Whether a fit runs along the row's wires (any direction when none were found).
+bool alongTheWires(const Cylinder& c, const std::vector<Eigen::Vector3d>& wire_directions) {
+  if (wire_directions.empty())
+    return true;
+  const Eigen::Vector2d level = c.axis.head<2>().normalized();
+  bool parallel = false;
+  for (const auto& w : wire_directions) {
+    parallel =
+        parallel || std::abs(level.dot(w.head<2>().normalized())) >= std::cos(MAX_WIRE_CROSSING);
+  }
+  return parallel;
+}
+
+/// A thin horizontal line that continues straight through the trunk and out of its other
+/// side is a trellis wire (a branch ends at the trunk); preprocessing misses wires that run
+/// shorter than wire_min_length inside a tight crop. The wires of a row are parallel: when
+/// preprocessing found some, a piece crossing them is no wire (a branch and the one opposite
+/// it continue each other's line as well).
+bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const PointIndex& index,
+                   double sigma, const std::vector<Eigen::Vector3d>& wire_directions) {
+  if (c.radius > MAX_WIRE_RADIUS || std::abs(c.axis.z()) > std::sin(MAX_WIRE_TILT))
+    return false;
+  if (!alongTheWires(c, wire_directions))
+    return false;
+  // Walk the axis backwards through the trunk and sample its far side.
+  Eigen::Vector3d through;
+  lineGap(c.center, c.axis, trunk_segment.center, trunk_segment.axis, &through);
+  const double t_trunk = (through - c.center).dot(c.axis);
+  const double tolerance = WIRE_TOLERANCE + sigma;
+  int samples = 0, occupied = 0;
+  for (double d = trunk_segment.radius + WIRE_FAR_FROM; d <= trunk_segment.radius + WIRE_FAR_TO;
+       d += WIRE_STEP) {
+    const Eigen::Vector3d q = c.center + (t_trunk - d) * c.axis;
+    ++samples;
+    occupied += index.countWithin(q, tolerance, 1) > 0;
+  }
+  return samples > 0 && occupied >= WIRE_OCCUPIED_SHARE * samples;
+}
+
+/// Whether returns fill a fit's axis from inner_gap off the trunk surface out to the fit's
+/// nearest point (gap), at CUT_FILL_SHARE of the density around the fit's centre: a branch
+/// crossing another near the trunk is cut in two by the other's extraction, and its outer
+/// part starts away from the surface, while a neighbour's tip or a shoot in the shell has air
+/// between it and the trunk.
+bool filledToSurface(const Cylinder& fit, const Cylinder& seg, const PointIndex& index,
+                     double inner_gap, double gap, double tube) {
+  const double own = static_cast<double>(index.within(fit.center, tube).size());
+  const int needed =
+      std::max(CUT_FILL_MIN_POINTS, static_cast<int>(std::ceil(CUT_FILL_SHARE * own)));
+  return walkToSurface(fit, seg, inner_gap, gap, [&](const Eigen::Vector3d& q) {
+    return index.countWithin(q, tube, needed) >= needed;
+  });
+}
+
+}  // namespace
+
+bool walkToSurface(const Cylinder& fit, const Cylinder& seg, double inner_gap, double gap,
+                   const std::function<bool(const Eigen::Vector3d&)>& visit) {
+  double last = 1e300;
+  for (double t = 0.0; t < CUT_WALK_REACH; t += CUT_WALK_STEP) {
+    const Eigen::Vector3d q = fit.center - t * fit.axis;
+    const double d = axisDistance(seg, q) - seg.radius;
+    if (d < inner_gap || d > last)
+      return true;
+    last = d;
+    if (d <= gap && !visit(q))
+      return false;
+  }
+  return false;
+}
+
+RejectedBranch rejection(const Points& pts, const std::vector<int>& members, BranchRejection reason,
+                         bool budget_spent) {
+  RejectedBranch r;
+  for (const int k : members)
+    r.centroid += pts[k];
+  r.centroid /= static_cast<double>(members.size());
+  r.points = static_cast<int>(members.size());
+  r.reason = reason;
+  r.budget_spent = budget_spent;
+  return r;
+}
+
+BranchSearch::BranchSearch(const BranchContext& context, const BranchCandidates& candidates,
+                           std::vector<RejectedBranch>* rejected)
+    : context_(context), candidates_(candidates), rejected_(rejected) {}
+
+void BranchSearch::run(const std::vector<std::vector<int>>& clusters) {
+  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
+    work_.push_back({*it, std::nullopt});
+  while (!work_.empty()) {
+    const Candidate candidate = std::move(work_.back());
+    work_.pop_back();
+    examine(candidate);
+  }
+}
+
+bool BranchSearch::budgetLeft() const {
+  return extractions_ < context_.config.branch_search_budget;
+}
+
+/// One candidate: fit a cylinder to its near part, check it is a primary (else split or turn
+/// the candidate down), take a wire's points out, keep a branch and search what is left.
+void BranchSearch::examine(const Candidate& candidate) {
+  const ModelerConfig& config = context_.config;
+  const NearPart near = nearPart(candidate.members);
+  if (static_cast<int>(near.pts.size()) < config.branch_min_points)
+    return reject(candidate, near.segment, {BranchRejection::TOO_FEW_POINTS, false});
+  const Cylinder& seg = context_.trunk.cylinders[near.segment];
+  const auto guess = direction(near, seg);
+  if (!guess)
+    return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
+  std::vector<int> inliers;
+  auto cyl = fit(near, seg, *guess, &inliers);
+  if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points)
+    return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
+  if (cyl->axis.dot(guess->radial) < 0.0)
+    cyl->axis = -cyl->axis;
+  Eigen::Vector3d attachment;
+  const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
+  bool reaches_surface = true;
+  if (config.ours_constrain_ransac) {
+    if (auto verdict = checkDirection(candidate, *cyl, seg, *guess, gap))
+      return reject(candidate, near.segment, *verdict);
+    reaches_surface = reachesSurface(near);
+    // A branch crossing this one near the trunk may have taken its near part out with it.
+    if (!reaches_surface &&
+        !(config.branch_keep_cut_off &&
+          filledToSurface(*cyl, seg, context_.index, context_.bands.inner_gap, near.nearest_gap,
+                          cyl->radius + context_.bands.threshold)))
+      return reject(candidate, near.segment, {BranchRejection::NOT_AT_THE_SURFACE, true});
+    if (auto verdict = checkPlace(candidate, *cyl, attachment))
+      return reject(candidate, near.segment, *verdict);
+  }
+  if (config.ours_remove_clutter &&
+      looksLikeWire(*cyl, seg, context_.index, context_.bands.sigma, context_.wire_directions)) {
+    // A wire passing close to a branch joins its cluster: the wire's points go, the rest is
+    // looked at again.
+    const std::vector<int> wire = searchRest(candidate.members, *cyl);
+    if (rejected_ && !wire.empty())
+      rejected_->push_back(rejection(candidates_.pts, wire, BranchRejection::WIRE));
+    return;
+  }
+  accept(candidate, near, *cyl, inliers, attachment, reaches_surface);
+}
+
+BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) const {
+  NearPart near;
+  near.segment = candidates_.where[cluster.front()].segment;
+  for (const int k : cluster) {
+    const TrunkCoords& c = candidates_.where[k];
+    const double gap = c.distance - context_.trunk.cylinders[c.segment].radius;
+    if (gap < near.nearest_gap) {
+      near.nearest_gap = gap;
+      near.segment = c.segment;
+    }
+    if (gap <= context_.config.branch_fit_length) {
+      near.pts.push_back(candidates_.pts[k]);
+      near.index.push_back(candidates_.index[k]);
+    }
+  }
+  return near;
+}
+
+/// The axis the fit starts from: the near part's own direction, pointing away from the trunk.
+/// A steep scaffold (central leaders) leaves the trunk more upwards than outwards; its part in
+/// the shell is a long, clearly directed cluster, and its own direction is kept up to
+/// branch_max_steep_angle from the radial. A short or round cluster's direction says little:
+/// the radial replaces it beyond branch_max_radial_angle. None when the near part sits on the
+/// trunk axis.
+std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& near,
+                                                               const Cylinder& seg) const {
+  const ModelerConfig& config = context_.config;
+  Eigen::Vector3d centroid;
+  Eigen::Vector3d spread;
+  Eigen::Vector3d axis = principalAxis(near.pts, &centroid, &spread);
+  Eigen::Vector3d radial =
+      (centroid - seg.center) - (centroid - seg.center).dot(seg.axis) * seg.axis;
+  if (radial.norm() < 1e-9)
+    return std::nullopt;
+  radial.normalize();
+  if (axis.dot(radial) < 0.0)
+    axis = -axis;
+  const bool elongated = spread(2) > STEEP_ELONGATION * spread(1);
+  const double max_angle =
+      (elongated ? config.branch_max_steep_angle : config.branch_max_radial_angle) * DEG;
+  if (config.ours_constrain_ransac && angleBetween(axis, radial) > max_angle)
+    axis = radial;
+  return Direction{radial, axis, max_angle};
+}
+
+/// The cylinder of the near part: ours a thin-cylinder fit (its radius through the branch
+/// calibration when there is one), the paper's a RANSAC cylinder.
+std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& seg,
+                                          const Direction& guess, std::vector<int>* inliers) {
+  const ModelerConfig& config = context_.config;
+  const BranchBands& bands = context_.bands;
+  CylinderRansacOptions o;
+  o.threshold = bands.threshold;
+  o.circle_iterations = config.ransac_iterations / 2;
+  o.axis_candidates = AXIS_CANDIDATES;
+  o.max_axis_deviation =
+      config.ours_constrain_ransac ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
+  o.min_radius = MIN_BRANCH_RADIUS;
+  o.max_radius = config.ours_constrain_ransac ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius)
+                                              : PAPER_MAX_BRANCH_RADIUS;
+  o.seed = config.seed * FIT_SEED_FACTOR + stream_++;
+  if (!config.ours_constrain_ransac)
+    return ransacCylinder(near.pts, guess.axis, o, inliers);
+  // With a branch calibration the fit reports the raw RMS radius and the table maps it.
+  const bool calibrated = config.ours_correct_noise_bias && config.branch_calibration.valid();
+  const bool raw = calibrated || config.branch_raw_radius;
+  auto cyl = fitThinCylinder(near.pts, guess.axis, bands.sigma, raw ? 0.0 : bands.scatter,
+                             o.max_radius, o.seed, inliers);
+  if (cyl && calibrated && !config.branch_raw_radius)
+    cyl->radius = config.branch_calibration.correct(cyl->radius, bands.sigma, MIN_BRANCH_RADIUS);
+  return cyl;
+}
+
+/// Seen along the trunk a primary points away from it, whatever its elevation; a fit across
+/// two branches, or a branch and a shoot, points sideways. Primaries leave the trunk between
+/// about 20 deg below and 45 deg above the horizontal, no thicker than the trunk there, and
+/// their axis passes the trunk's: a fit that dives, is wider than the trunk or misses it took
+/// in something else (a shoot hanging from the branch, a neighbour).
+std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidate& candidate,
+                                                                  const Cylinder& fit,
+                                                                  const Cylinder& seg,
+                                                                  const Direction& guess,
+                                                                  double gap) const {
+  const ModelerConfig& config = context_.config;
+  const Eigen::Vector3d across = fit.axis - fit.axis.dot(seg.axis) * seg.axis;
+  const bool sideways =
+      across.norm() > MIN_ACROSS_SHARE &&
+      angleBetween(across.normalized(), guess.radial) > config.branch_max_azimuth * DEG;
+  const bool off_ray = candidate.ray && std::acos(std::clamp(std::abs(fit.axis.dot(*candidate.ray)),
+                                                             -1.0, 1.0)) > RAY_AGREEMENT;
+  if (off_ray)
+    return Verdict{BranchRejection::OFF_ITS_RAY, true};
+  if (angleBetween(fit.axis, guess.radial) > guess.max_angle || sideways)
+    return Verdict{BranchRejection::NOT_RADIAL, true};
+  if (angleBetween(fit.axis, seg.axis) > (90.0 - config.branch_min_elevation) * DEG)
+    return Verdict{BranchRejection::POINTS_DOWN, true};
+  if (fit.radius > config.branch_max_diameter_ratio * seg.radius)
+    return Verdict{BranchRejection::THICKER_THAN_THE_TRUNK, true};
+  if (gap > seg.radius + config.branch_axis_gap)
+    return Verdict{BranchRejection::MISSES_THE_TRUNK, true};
+  return std::nullopt;
+}
+
+bool BranchSearch::reachesSurface(const NearPart& near) const {
+  return near.nearest_gap <= SURFACE_CONTACT + context_.bands.inner_gap;
+}
+
+/// Primaries are at least branch_min_length long and start above the ground: a short fragment
+/// is a spur, a shoot or what an extraction left of a branch; near the ground it is mixed
+/// pixels between the trunk base and the soil. A short fit to a large candidate ran across it
+/// (two branches meeting, a branch and its shoot): the halves may each hold a branch.
+std::optional<BranchSearch::Verdict> BranchSearch::checkPlace(
+    const Candidate& candidate, const Cylinder& fit, const Eigen::Vector3d& attachment) const {
+  const ModelerConfig& config = context_.config;
+  if (fit.length < config.branch_min_length) {
+    const bool large =
+        static_cast<int>(candidate.members.size()) >= SHORT_SPLIT * config.branch_min_points;
+    return Verdict{BranchRejection::TOO_SHORT, large};
+  }
+  if (attachment.z() - context_.trunk.baseZ() < config.branch_min_height)
+    return Verdict{BranchRejection::TOO_LOW, false};
+  return std::nullopt;
+}
+
+void BranchSearch::accept(const Candidate& candidate, const NearPart& near, const Cylinder& fit,
+                          const std::vector<int>& inliers, const Eigen::Vector3d& attachment,
+                          bool reaches_surface) {
+  const ModelerConfig& config = context_.config;
+  const BranchBands& bands = context_.bands;
+  Points in;
+  BranchFit branch;
+  for (const int i : inliers) {
+    in.push_back(near.pts[i]);
+    branch.inliers.push_back(near.index[i]);
+  }
+  branch.cylinder = fit;
+  if (config.ours_correct_noise_bias && !config.ours_constrain_ransac) {
+    branch.cylinder.radius =
+        noiseCorrectedRadius(fit, in, bands.sigma, bands.threshold, MIN_BRANCH_RADIUS);
+  }
+  branch.candidates = near.pts.size();
+  branch.trunk_segment = near.segment;
+  branch.attachment = attachment;
+  branch.reaches_surface = reaches_surface;
+  if (reaches_surface) {
+    branches_.push_back(std::move(branch));
+  } else {
+    cut_.push_back(
+        {std::move(branch), near.nearest_gap,
+         rejection(candidates_.pts, candidate.members, BranchRejection::NOT_AT_THE_SURFACE)});
+  }
+  if (config.ours_constrain_ransac)
+    searchRest(candidate.members, fit);
+}
+
+/// A candidate that fits no branch may be several branches fused into one cluster (close
+/// neighbours, a shoot bridging two): parted along its strongest ray, or split in two by
+/// position, while the budget lasts. Else it is turned down, and said so.
+void BranchSearch::reject(const Candidate& candidate, int segment, Verdict verdict) {
+  const ModelerConfig& config = context_.config;
+  const bool could_split =
+      verdict.splittable && config.ours_constrain_ransac &&
+      static_cast<int>(candidate.members.size()) >= SPLIT_MIN_SIZE * config.branch_min_points;
+  if (could_split && budgetLeft()) {
+    Points cluster_pts;
+    for (const int k : candidate.members)
+      cluster_pts.push_back(candidates_.pts[k]);
+    if (splitAlongRay(candidate, cluster_pts, segment) || splitInHalves(candidate, cluster_pts))
+      return;
+  }
+  if (rejected_) {
+    rejected_->push_back(rejection(candidates_.pts, candidate.members, verdict.reason,
+                                   could_split && !budgetLeft()));
+  }
+}
+
+/// Branches leave the trunk as rays: the points along the strongest ray through the candidate
+/// are one candidate, the rest others. Once parted, a candidate is halved by position instead.
+bool BranchSearch::splitAlongRay(const Candidate& candidate, const Points& cluster_pts,
+                                 int segment) {
+  const ModelerConfig& config = context_.config;
+  const double sigma = context_.bands.sigma;
+  if (!config.branch_ray_split || sigma < config.branch_ray_split_min_noise || candidate.ray)
+    return false;
+  const auto ray = strongestRay(cluster_pts, context_.trunk.cylinders[segment],
+                                config.branch_min_elevation, config.branch_max_steep_angle);
+  if (!ray)
+    return false;
+  const double tube = std::max(noiseBand(sigma), RAY_MIN_BAND) + RAY_TUBE_RADIUS;
+  std::vector<int> on, rest;
+  for (const int k : candidate.members)
+    (rayDistance(*ray, candidates_.pts[k]) < tube ? on : rest).push_back(k);
+  if (static_cast<int>(on.size()) < config.branch_min_points || rest.empty())
+    return false;
+  work_.push_back({std::move(on), ray->direction});
+  ++extractions_;
+  pushParts(rest);
+  return true;
+}
+
+bool BranchSearch::splitInHalves(const Candidate& candidate, const Points& cluster_pts) {
+  const auto labels = kMeans(cluster_pts, 2, HALVES_ITERATIONS,
+                             context_.config.seed * HALVES_SEED_FACTOR + stream_++);
+  std::vector<int> halves[2];
+  for (std::size_t k = 0; k < candidate.members.size(); ++k)
+    halves[labels[k]].push_back(candidate.members[k]);
+  if (halves[0].empty() || halves[1].empty())
+    return false;
+  work_.push_back({std::move(halves[0]), std::nullopt});
+  work_.push_back({std::move(halves[1]), std::nullopt});
+  extractions_ += 2;
+  return true;
+}
+
+/// Takes a found line's points (a branch, a wire) out of a cluster and looks again at what
+/// remains of it. Returns the points taken out.
+std::vector<int> BranchSearch::searchRest(const std::vector<int>& cluster, const Cylinder& found) {
+  const BranchBands& bands = context_.bands;
+  const double reach =
+      found.radius + noiseBand(std::max(bands.sigma, bands.scatter)) + EXTRACTION_MARGIN;
+  std::vector<int> taken, rest;
+  for (const int k : cluster)
+    (axisDistance(found, candidates_.pts[k]) > reach ? rest : taken).push_back(k);
+  if (static_cast<int>(rest.size()) >= REMAINDER_MIN_SIZE * context_.config.branch_min_points) {
+    if (budgetLeft()) {
+      pushParts(rest);
+    } else if (rejected_) {
+      // Said, not silently dropped: what may hold another branch was not looked at.
+      rejected_->push_back(
+          rejection(candidates_.pts, rest, BranchRejection::REMAINDER_NOT_SEARCHED, true));
+    }
+  }
+  return taken;
+}
+
+/// Parts of a cluster are clustered again: a part may have fallen apart.
+void BranchSearch::pushParts(const std::vector<int>& rest) {
+  Points rest_pts;
+  for (const int k : rest)
+    rest_pts.push_back(candidates_.pts[k]);
+  const ModelerConfig& config = context_.config;
+  for (const auto& part :
+       euclideanClusters(rest_pts, config.branch_cluster_tolerance, config.branch_min_points)) {
+    std::vector<int> mapped;
+    for (const int k : part)
+      mapped.push_back(rest[k]);
+    work_.push_back({std::move(mapped), std::nullopt});
+    ++extractions_;
+  }
+}
+
+}  // namespace detail
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
