@@ -88,7 +88,7 @@ class Rig {
       q.target = target;
       q.velocity = velocity;
       const auto r = stage_->move(q);
-      if (!r.success)
+      if (!r.success())
         throw Error(ErrorCode::IO_FAILURE, r.message);
     };
     io.scan_period = [this] {

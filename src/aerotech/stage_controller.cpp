@@ -32,7 +32,7 @@ void StageController::setUp() {
     command_.enable(a->axis);
   if (config_.home_on_start) {
     const MoveResult r = home();
-    if (!r.success)
+    if (!r.success())
       throw Error(ErrorCode::IO_FAILURE, r.message);
   }
 }
@@ -46,7 +46,7 @@ MoveResult StageController::home() {
       command_.enable(a->axis);
       command_.home(a->axis);
     }
-    r.success = true;
+    r.status = MoveStatus::OK;
     r.message = "homed";
     r.position = 0.0;
   } catch (const Error& e) {
@@ -66,6 +66,7 @@ MoveResult StageController::move(const MoveRequest& q) {
   }
   if (!std::isfinite(q.target) || !std::isfinite(q.velocity) || q.velocity < 0) {
     r.message = "target must be finite and velocity finite and >= 0";
+    r.status = MoveStatus::REFUSED;
     return r;
   }
   try {
@@ -77,6 +78,7 @@ MoveResult StageController::move(const MoveRequest& q) {
         << a->max_position << "] of axis " << a->axis;
       r.message = m.str();
       r.position = now;
+      r.status = MoveStatus::REFUSED;
       return r;
     }
     const double velocity = q.velocity > 0 ? q.velocity : a->default_velocity;
@@ -86,7 +88,7 @@ MoveResult StageController::move(const MoveRequest& q) {
       command_.waitForMove(a->axis, timeout);
     }
     r.position = command_.position(a->axis) / a->scale;
-    r.success = true;
+    r.status = MoveStatus::OK;
     r.message = q.wait ? "in position" : "moving";
   } catch (const Error& e) {
     r.message = e.what();

@@ -227,8 +227,8 @@ void AcquisitionNode::run() {
                     "the stage service " + move_service_ + " is not available");
       if (m.response.success)
         return;
-      if (m.response.message.rfind("stage not ready", 0) != 0 || ros::WallTime::now() > give_up ||
-          cancel_)
+      if (m.response.status != dormant_tree_modeling::MoveAxis::Response::NOT_READY ||
+          ros::WallTime::now() > give_up || cancel_)
         throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
       ros::WallDuration(0.5).sleep();
     }

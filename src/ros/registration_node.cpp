@@ -58,13 +58,6 @@ std::string defaultOutputDir() {
   return "registration";
 }
 
-// The same platform position: the hint moved by less than a millimetre and a hundredth of a
-// degree (a static transform republished, not a platform move).
-bool samePlace(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
-  const Eigen::Isometry3d d = a.inverse() * b;
-  return d.translation().norm() < 1e-3 && Eigen::AngleAxisd(d.linear()).angle() < 1.75e-4;
-}
-
 }  // namespace
 
 RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
@@ -167,10 +160,7 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
   std::optional<int> planned;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!hint || !last_hint_ || !samePlace(*hint, *last_hint_) || views_.empty())
-      ++next_station_;
-    last_hint_ = hint;
-    v.station = next_station_;
+    v.station = stations_.next(hint);
     v.station_hint = hint;
     v.name = "view_" + std::to_string(views_.size());
     views_.push_back(std::move(v));
@@ -272,7 +262,7 @@ bool RegistrationNode::resetService(std_srvs::Trigger::Request&, std_srvs::Trigg
   std::lock_guard<std::mutex> lock(mutex_);
   res.message = "dropped " + std::to_string(views_.size()) + " views";
   views_.clear();
-  last_hint_.reset();
+  stations_.restart();
   awaited_views_.reset();
   res.success = true;
   return true;
@@ -298,7 +288,7 @@ bool RegistrationNode::startRegistration(std::string& why,
     }
     // The views go to the worker; new ones start the next tree.
     views.swap(views_);
-    last_hint_.reset();
+    stations_.restart();
     awaited_views_.reset();
     stamp = last_stamp_;
     busy_ = true;

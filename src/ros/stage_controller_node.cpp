@@ -74,6 +74,22 @@ geometry_msgs::TransformStamped transform(const std::string& parent, const std::
   return m;
 }
 
+/// The service's status code for a move's outcome.
+std::uint8_t moveStatus(aerotech::MoveStatus status) {
+  using Response = dormant_tree_modeling::MoveAxis::Response;
+  switch (status) {
+    case aerotech::MoveStatus::OK:
+      return Response::OK;
+    case aerotech::MoveStatus::NOT_READY:
+      return Response::NOT_READY;
+    case aerotech::MoveStatus::REFUSED:
+      return Response::REFUSED;
+    case aerotech::MoveStatus::FAILED:
+      break;
+  }
+  return Response::FAILED;
+}
+
 }  // namespace
 
 StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
@@ -241,6 +257,7 @@ bool StageControllerNode::moveAxis(dormant_tree_modeling::MoveAxis::Request& req
                                    dormant_tree_modeling::MoveAxis::Response& res) {
   if (!ready_) {
     std::lock_guard<std::mutex> lock(status_mutex_);
+    res.status = dormant_tree_modeling::MoveAxis::Response::NOT_READY;
     res.success = false;
     res.message = "stage not ready: " + (last_error_.empty() ? "setting up" : last_error_);
     return true;
@@ -253,10 +270,11 @@ bool StageControllerNode::moveAxis(dormant_tree_modeling::MoveAxis::Request& req
   q.wait = req.wait;
   const aerotech::MoveResult r = stage_->move(q);
   noteReconnects();
-  res.success = r.success;
+  res.status = moveStatus(r.status);
+  res.success = r.success();
   res.message = r.message;
   res.position = r.position;
-  if (!r.success) {
+  if (!r.success()) {
     std::lock_guard<std::mutex> lock(status_mutex_);
     last_error_ = r.message;
     ROS_ERROR("move_axis %s: %s", req.axis.c_str(), r.message.c_str());
@@ -266,7 +284,7 @@ bool StageControllerNode::moveAxis(dormant_tree_modeling::MoveAxis::Request& req
 
 bool StageControllerNode::home(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   const aerotech::MoveResult r = stage_->home();
-  res.success = r.success;
+  res.success = r.success();
   res.message = r.message;
   return true;
 }

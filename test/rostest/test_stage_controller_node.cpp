@@ -52,12 +52,17 @@ TEST(StageControllerNode, MovesReportsFaultsAndPublishesStateAndTf) {
   // Set-up (enable, home) runs in the background: wait until a move is accepted.
   dormant_tree_modeling::MoveAxis first;
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(20.0);
+  using Response = dormant_tree_modeling::MoveAxis::Response;
   do {
     first = move("slide_joint", 0.2);  // by joint name; m
-    if (!first.response.success)
+    if (!first.response.success) {
+      // Only a stage still setting up may refuse a valid move: say it is not ready.
+      EXPECT_EQ(first.response.status, Response::NOT_READY) << first.response.message;
       ros::WallDuration(0.2).sleep();
+    }
   } while (!first.response.success && ros::WallTime::now() < give_up);
   ASSERT_TRUE(first.response.success) << first.response.message;
+  EXPECT_EQ(first.response.status, Response::OK);
   EXPECT_NEAR(first.response.position, 0.2, 1e-6);
 
   // Joint states at >= 50 Hz.
@@ -71,12 +76,14 @@ TEST(StageControllerNode, MovesReportsFaultsAndPublishesStateAndTf) {
   // Soft limits are checked before anything moves.
   const auto limit = move("X", 150.0);
   EXPECT_FALSE(limit.response.success);
+  EXPECT_EQ(limit.response.status, Response::REFUSED);
   EXPECT_NE(limit.response.message.find("soft limits"), std::string::npos)
       << limit.response.message;
 
   // The emulator faults this move half-way: a clear error, not a hang.
   const auto faulted = move("X", 30.0);
   EXPECT_FALSE(faulted.response.success);
+  EXPECT_EQ(faulted.response.status, Response::FAILED);
   EXPECT_NE(faulted.response.message.find("position error"), std::string::npos)
       << faulted.response.message;
 

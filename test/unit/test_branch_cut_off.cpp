@@ -28,7 +28,7 @@ void addBranchPart(Points& pts, double from, double to) {
   addCylinder(pts, surface + from * OUT, OUT, BRANCH_RADIUS, to - from);
 }
 
-int countReason(const std::vector<RejectedBranch>& rejected, const std::string& reason) {
+int countReason(const std::vector<RejectedBranch>& rejected, BranchRejection reason) {
   int n = 0;
   for (const auto& r : rejected)
     n += r.reason == reason;
@@ -51,12 +51,12 @@ TEST(BranchCutOff, ABranchWhoseReturnsBreakOffNearTheTrunkIsKept) {
   EXPECT_GT(kept[0].cylinder.axis.dot(OUT), std::cos(5.0 * M_PI / 180));
   EXPECT_NEAR(kept[0].attachment.z(), 0.9, 0.03);
   EXPECT_FALSE(kept[0].reaches_surface);
-  EXPECT_EQ(countReason(rejected, "too short"), 1);  // the piece at the trunk
+  EXPECT_EQ(countReason(rejected, BranchRejection::TOO_SHORT), 1);  // the piece at the trunk
 
   config.branch_keep_cut_off = false;
   rejected.clear();
   EXPECT_TRUE(modelBranches(pts, index, trunk, region, config, &rejected).empty());
-  EXPECT_GE(countReason(rejected, "not at the surface"), 1);  // and its halves, retried
+  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE), 1);  // and its halves, retried
 }
 
 TEST(BranchCutOff, ATipWithAirBetweenItAndTheTrunkIsNot) {
@@ -67,7 +67,7 @@ TEST(BranchCutOff, ATipWithAirBetweenItAndTheTrunkIsNot) {
   auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   std::vector<RejectedBranch> rejected;
   EXPECT_TRUE(modelBranches(pts, PointIndex(pts), trunk, region, config, &rejected).empty());
-  EXPECT_GE(countReason(rejected, "not at the surface"), 1);  // and its halves, retried
+  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE), 1);  // and its halves, retried
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "dormant_tree_modeling/registration/coarse_search.h"
 #include "dormant_tree_modeling/registration/icp.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/stations.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/ray_caster.h"
@@ -318,6 +319,35 @@ TEST(RegistrationJson, RecordsWhatEndedTheInputAndWhetherEveryReportedViewCame) 
   EXPECT_STREQ(endName(End::REQUEST), "request");
   EXPECT_FALSE((RegistrationInput{End::REQUEST, 40, 40}.complete()))
       << "a service call knows no end";
+}
+
+Eigen::Isometry3d hintAt(double x, double yaw_rad) {
+  return Eigen::Translation3d(x, -1.5, 1.5) * Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ());
+}
+
+TEST(StationGrouper, ViewsWithTheSameHintShareAStationAndAMoveStartsTheNext) {
+  StationGrouper g;
+  EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 1);
+  EXPECT_EQ(g.next(hintAt(0.0005, 0.0)), 1) << "0.5 mm is the same place";
+  EXPECT_EQ(g.next(hintAt(0.0005, 1e-4)), 1) << "0.006 deg is the same place";
+  EXPECT_EQ(g.next(hintAt(0.0025, 1e-4)), 2) << "2 mm is a move";
+  EXPECT_EQ(g.next(hintAt(0.0025, 5e-4)), 3) << "0.03 deg is a turn";
+  EXPECT_EQ(g.next(hintAt(0.0025, 5e-4)), 3);
+}
+
+TEST(StationGrouper, AViewWithoutAHintStartsItsOwnStation) {
+  StationGrouper g;
+  EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 1);
+  EXPECT_EQ(g.next(std::nullopt), 2);
+  EXPECT_EQ(g.next(std::nullopt), 3) << "nothing says the platform stood still";
+  EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 4) << "the hint before the unhinted views is not used";
+}
+
+TEST(StationGrouper, AfterARestartTheNextViewStartsANewStation) {
+  StationGrouper g;
+  EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 1);
+  g.restart();
+  EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 2) << "the next tree's views are not the last tree's";
 }
 
 }  // namespace

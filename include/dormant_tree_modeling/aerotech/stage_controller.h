@@ -18,11 +18,21 @@ struct MoveRequest {
   bool wait = true;
 };
 
+/// @brief How a move or homing ended; the ROS service replies carry it as `status`.
+enum class MoveStatus {
+  OK,         ///< in position (or moving, for a move that does not wait), or homed
+  NOT_READY,  ///< the stage is still connecting or setting up: the same request may succeed later
+  REFUSED,    ///< the request is invalid (unknown axis, non-finite value, beyond the soft limits)
+  FAILED,     ///< the controller failed it (axis fault, timeout, lost connection)
+};
+
 /// @brief What became of a move.
 struct MoveResult {
-  bool success = false;
+  MoveStatus status = MoveStatus::FAILED;
   std::string message;
   double position = 0;  ///< feedback after the command, service units
+
+  bool success() const { return status == MoveStatus::OK; }
 };
 
 /// @brief Feedback of both axes, sampled together.

@@ -16,6 +16,7 @@
 
 #include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/stations.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
@@ -89,8 +90,7 @@ class RegistrationNode {
 
   std::mutex mutex_;
   std::vector<registration::ViewInput> views_;
-  std::optional<Eigen::Isometry3d> last_hint_;
-  int next_station_ = 0;
+  registration::StationGrouper stations_;
   ros::Time last_stamp_;
   /// Set between a plan's end and the arrival of the views it names.
   std::optional<int> awaited_views_;
