@@ -56,7 +56,8 @@ TEST(BranchCutOff, ABranchWhoseReturnsBreakOffNearTheTrunkIsKept) {
   config.branch_keep_cut_off = false;
   rejected.clear();
   EXPECT_TRUE(modelBranches(pts, index, trunk, region, config, &rejected).empty());
-  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE), 1);  // and its halves, retried
+  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE),
+            1);  // and its halves, retried
 }
 
 TEST(BranchCutOff, ATipWithAirBetweenItAndTheTrunkIsNot) {
@@ -67,7 +68,8 @@ TEST(BranchCutOff, ATipWithAirBetweenItAndTheTrunkIsNot) {
   auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   std::vector<RejectedBranch> rejected;
   EXPECT_TRUE(modelBranches(pts, PointIndex(pts), trunk, region, config, &rejected).empty());
-  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE), 1);  // and its halves, retried
+  EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE),
+            1);  // and its halves, retried
 }
 
 }  // namespace
