@@ -53,7 +53,7 @@ roslaunch dormant_tree_modeling demo.launch preset:="$preset" seed:="$seed" nois
 launch_pid=$!
 pids+=($launch_pid)
 
-# The latest message of a std_msgs/String topic, on one line.
+# The latest value of a topic's field (topic/field), on one line.
 progress() { timeout 5 rostopic echo -n1 -p "$1" 2>/dev/null | sed -n '2s/^[^,]*,//p'; }
 last=""
 model="$run/model/model.json"
@@ -67,7 +67,7 @@ while [[ ! -f "$model" ]]; do
     echo "demo: no model after $timeout_s s; the last progress: $last (log: $run/ros.log)" >&2
     exit 1
   fi
-  now="$(progress /acquisition/progress)"
+  now="$(progress /acquisition/progress/text)"
   if [[ -n "$now" && "$now" != "$last" ]]; then
     say "acquisition: $now"
     last="$now"

@@ -40,6 +40,7 @@ std::vector<ViewOutcome> runPlan(const std::vector<PlannedView>& plan, const Seq
   };
   int platform_index = -1;
   for (const auto& view : plan) {
+    p.view = view.index + 1;
     if (a.cancelled && a.cancelled()) {
       report("cancelled");
       break;

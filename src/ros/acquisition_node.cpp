@@ -21,6 +21,7 @@ namespace {
 
 // Rate of the platform pose on /tf: a lookup at a view's time waits at most one period.
 constexpr double PLATFORM_TF_HZ = 20.0;
+using Progress = dormant_tree_modeling::AcquisitionProgress;
 
 }  // namespace
 
@@ -57,7 +58,7 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   if (!(service_wait_s_ > 0 && service_wait_s_ <= 600))
     throw Error(ErrorCode::INVALID_ARGUMENT, "~service_wait must be in (0, 600] s");
   prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
-  progress_pub_ = pnh.advertise<std_msgs::String>("progress", 1, true);
+  progress_pub_ = pnh.advertise<dormant_tree_modeling::AcquisitionProgress>("progress", 1, true);
   goal_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_goal", 1, true);
   start_srv_ = pnh.advertiseService("start", &AcquisitionNode::start, this);
   cancel_srv_ = pnh.advertiseService("cancel", &AcquisitionNode::cancel, this);
@@ -68,7 +69,12 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
         topic, 1000, boost::bind(&AcquisitionNode::record, this, topic, boost::placeholders::_1)));
   }
   total_ = static_cast<int>(acquisition::makeViewPlan(plan_).size());
-  publish(progress_pub_, "idle: " + std::to_string(total_) + " views planned; call ~start");
+  {
+    acquisition::SequencerProgress idle;
+    idle.total = total_;
+    publishProgress(Progress::IDLE, idle,
+                    "idle: " + std::to_string(total_) + " views planned; call ~start");
+  }
   diagnostics_.setHardwareID("none");
   diagnostics_.add("acquisition", this, &AcquisitionNode::diagnose);
   diagnostics_timer_ =
@@ -103,6 +109,25 @@ void AcquisitionNode::publish(ros::Publisher& pub, const std::string& text) {
   std_msgs::String m;
   m.data = text;
   pub.publish(m);
+}
+
+dormant_tree_modeling::AcquisitionProgress AcquisitionNode::progressMessage(
+    std::uint8_t state, const acquisition::SequencerProgress& p, const std::string& text) {
+  dormant_tree_modeling::AcquisitionProgress m;
+  m.state = state;
+  m.view = p.view;
+  m.done = p.done;
+  m.failed = p.failed;
+  m.planned = p.total;
+  m.elapsed_s = p.elapsed_s;
+  m.remaining_s = p.remaining_s;
+  m.text = text;
+  return m;
+}
+
+void AcquisitionNode::publishProgress(std::uint8_t state, const acquisition::SequencerProgress& p,
+                                      const std::string& text) {
+  progress_pub_.publish(progressMessage(state, p, text));
 }
 
 void AcquisitionNode::record(const std::string& topic,
@@ -195,7 +220,10 @@ void AcquisitionNode::run() {
     bag_.open(bag_path, rosbag::bagmode::Write);
     recording_ = true;
   } catch (const rosbag::BagException& e) {
-    publish(progress_pub_, std::string("cannot record to ") + bag_path + ": " + e.what());
+    acquisition::SequencerProgress none;
+    none.total = static_cast<int>(plan.size());
+    publishProgress(Progress::FAILED, none,
+                    std::string("cannot record to ") + bag_path + ": " + e.what());
     ROS_ERROR("cannot record to %s: %s", bag_path.c_str(), e.what());
     std::lock_guard<std::mutex> lock(mutex_);
     last_problem_ = std::string("cannot record to ") + bag_path + ": " + e.what();
@@ -208,6 +236,7 @@ void AcquisitionNode::run() {
     state_ = "running";
     done_ = failed_ = 0;
     total_ = static_cast<int>(plan.size());
+    last_progress_ = acquisition::SequencerProgress{};
     last_problem_.clear();
   }
   acquisition::SequencerActions a;
@@ -245,7 +274,8 @@ void AcquisitionNode::run() {
   };
   a.progress = [this](const acquisition::SequencerProgress& p) {
     const std::string line = acquisition::progressLine(p);
-    publish(progress_pub_, line);
+    publishProgress(Progress::RUNNING, p, line);
+    last_progress_ = p;
     ROS_INFO("%s", line.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
     done_ = p.done;
@@ -265,8 +295,13 @@ void AcquisitionNode::run() {
   ros::WallDuration(drain_s_).sleep();
   const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
   const std::string summary = report.substr(0, report.find('\n'));
-  std_msgs::String finished;
-  finished.data = "finished: " + summary;
+  acquisition::SequencerProgress end = last_progress_;
+  end.total = static_cast<int>(plan.size());
+  end.done = 0;
+  end.failed = 0;
+  for (const auto& o : outcomes)
+    (o.ok ? end.done : end.failed) += 1;
+  const auto finished = progressMessage(Progress::FINISHED, end, "finished: " + summary);
   {
     std::lock_guard<std::mutex> lock(bag_mutex_);
     recording_ = false;

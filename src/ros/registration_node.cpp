@@ -1,5 +1,6 @@
 #include "dormant_tree_modeling/ros/registration_node.h"
 
+#include <dormant_tree_modeling/AcquisitionProgress.h>
 #include <geometry_msgs/PoseArray.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -60,6 +61,26 @@ std::string defaultOutputDir() {
 
 }  // namespace
 
+std::optional<PlanEnd> planEnd(const topic_tools::ShapeShifter& msg) {
+  if (msg.getDataType() ==
+      ros::message_traits::datatype<dormant_tree_modeling::AcquisitionProgress>()) {
+    const auto p = msg.instantiate<dormant_tree_modeling::AcquisitionProgress>();
+    if (!p || p->state != dormant_tree_modeling::AcquisitionProgress::FINISHED)
+      return std::nullopt;
+    return PlanEnd{p->done};
+  }
+  if (msg.getDataType() == ros::message_traits::datatype<std_msgs::String>()) {
+    const auto text = msg.instantiate<std_msgs::String>();
+    if (!text || text->data.rfind("finished", 0) != 0)
+      return std::nullopt;
+    return PlanEnd{acquisition::viewsAcquired(text->data)};
+  }
+  ROS_WARN_ONCE("registration: progress of type %s ignored (expected %s)",
+                msg.getDataType().c_str(),
+                ros::message_traits::datatype<dormant_tree_modeling::AcquisitionProgress>());
+  return std::nullopt;
+}
+
 RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     : config_(loadConfig(pnh)), nh_(nh) {
   orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
@@ -91,7 +112,8 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   view_sub_ = nh.subscribe("view_cloud", 50, &RegistrationNode::viewCallback, this);
   const std::string progress = pnh.param<std::string>("plan_progress_topic", "");
   if (!progress.empty())
-    progress_sub_ = nh.subscribe(progress, 10, &RegistrationNode::progressCallback, this);
+    progress_sub_ = nh.subscribe<topic_tools::ShapeShifter>(
+        progress, 10, &RegistrationNode::progressCallback, this);
   register_srv_ = pnh.advertiseService("register", &RegistrationNode::registerService, this);
   reset_srv_ = pnh.advertiseService("reset", &RegistrationNode::resetService, this);
 
@@ -187,10 +209,16 @@ void RegistrationNode::viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg)
   }
 }
 
-void RegistrationNode::progressCallback(const std_msgs::StringConstPtr& msg) {
-  if (msg->data.rfind("finished", 0) != 0)
+void RegistrationNode::progressCallback(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  std::optional<PlanEnd> end;
+  try {
+    end = planEnd(*msg);
+  } catch (const ros::Exception& e) {
+    ROS_WARN_THROTTLE(10.0, "registration: progress message not read: %s", e.what());
+  }
+  if (!end)
     return;
-  const std::optional<int> named = acquisition::viewsAcquired(msg->data);
+  const std::optional<int> named = end->views;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const int have = static_cast<int>(views_.size());

@@ -1,5 +1,6 @@
 // The acquisition sequencer on the virtual platform: a two-view plan, the operator prompt
 // answered, the run finished, the bag read back with every raw topic and both view clouds.
+#include <dormant_tree_modeling/AcquisitionProgress.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -12,24 +13,30 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 namespace {
 
 std::string g_output_dir;
 
+using Progress = dormant_tree_modeling::AcquisitionProgress;
+
 struct Watcher {
   std::mutex mutex;
   std::string prompt, progress;
+  Progress last;
   void onPrompt(const std_msgs::StringConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex);
     prompt = m->data;
   }
-  void onProgress(const std_msgs::StringConstPtr& m) {
+  void onProgress(const dormant_tree_modeling::AcquisitionProgressConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex);
-    progress = m->data;
+    progress = m->text;
+    last = *m;
   }
-  std::string get(std::string Watcher::*field) {
+  template <typename T>
+  T get(T Watcher::*field) {
     std::lock_guard<std::mutex> lock(mutex);
     return this->*field;
   }
@@ -60,13 +67,19 @@ TEST(AcquisitionNode, RunsAShortPlanAndWritesABagThatReadsBack) {
       ASSERT_TRUE(ros::service::call("/acquisition/platform_in_place", in_place));
       answered = true;
     }
-    if (w.get(&Watcher::progress).rfind("finished", 0) == 0)
+    if (w.get(&Watcher::last).state == Progress::FINISHED)
       break;
     ros::WallDuration(0.1).sleep();
   }
   const std::string progress = w.get(&Watcher::progress);
   std::printf("[ INFO ] %s\n", progress.c_str());
   ASSERT_EQ(progress.rfind("finished: 2 of 2 planned views acquired", 0), 0u) << progress;
+  const Progress end = w.get(&Watcher::last);
+  EXPECT_EQ(end.state, Progress::FINISHED);
+  EXPECT_EQ(end.done, 2);
+  EXPECT_EQ(end.failed, 0);
+  EXPECT_EQ(end.planned, 2);
+  EXPECT_EQ(end.view, 2) << "the last view in hand";
 
   std::ifstream report(g_output_dir + "/virtual_tree_report.md");
   ASSERT_TRUE(report.good());
@@ -87,6 +100,16 @@ TEST(AcquisitionNode, RunsAShortPlanAndWritesABagThatReadsBack) {
   EXPECT_GT(counts["/tf"], 0u);
   EXPECT_GT(counts["/tf_static"], 0u);
   EXPECT_EQ(counts["/assembler/view_cloud"], 2u);
+  // The bag ends with the plan's end, typed, so a replay knows how many views to wait for.
+  rosbag::View ends(bag, rosbag::TopicQuery("/acquisition/progress"));
+  std::optional<Progress> recorded_end;
+  for (const auto& m : ends) {
+    if (const auto p = m.instantiate<Progress>())
+      recorded_end = *p;
+  }
+  ASSERT_TRUE(recorded_end);
+  EXPECT_EQ(recorded_end->state, Progress::FINISHED);
+  EXPECT_EQ(recorded_end->done, 2);
   // The recorded scans deserialize as LaserScans.
   rosbag::View scans(bag, rosbag::TopicQuery("/lms111/scan"));
   const auto first = scans.begin()->instantiate<sensor_msgs::LaserScan>();

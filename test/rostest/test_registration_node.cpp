@@ -1,9 +1,11 @@
 // The registration node: views arriving as the scan assembler publishes them (platform frame,
 // the platform's hinted pose on tf) are registered on ~register into one tree cloud.
+#include <dormant_tree_modeling/AcquisitionProgress.h>
 #include <geometry_msgs/PoseArray.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Int32.h>
 #include <std_msgs/String.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -19,6 +21,7 @@
 
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/registration_node.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 
 namespace {
@@ -153,7 +156,8 @@ TEST(RegistrationNode, WaitsForTheViewsThePlansEndNames) {
   // A replay: the plan's end arrives while the last sweep is still being assembled.
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("view_cloud", 10);
-  ros::Publisher progress = nh.advertise<std_msgs::String>("/acquisition/progress", 10);
+  ros::Publisher progress =
+      nh.advertise<dormant_tree_modeling::AcquisitionProgress>("/acquisition/progress", 10);
   tf2_ros::StaticTransformBroadcaster hints;
   // The report is latched: the first test's comes first, this test's after it.
   std::mutex mutex;
@@ -170,8 +174,10 @@ TEST(RegistrationNode, WaitsForTheViewsThePlansEndNames) {
     before = reports.size();
   }
   publishViews(pub, hints, 0, 7);
-  std_msgs::String finished;
-  finished.data = "finished: 8 of 8 planned views acquired, 40 s of scanning.";
+  dormant_tree_modeling::AcquisitionProgress finished;
+  finished.state = dormant_tree_modeling::AcquisitionProgress::FINISHED;
+  finished.view = finished.done = finished.planned = 8;
+  finished.text = "finished: 8 of 8 planned views acquired, 40 s of scanning.";
   progress.publish(finished);
   ros::Duration(1.0).sleep();
   publishViews(pub, hints, 7, 8);
@@ -184,6 +190,47 @@ TEST(RegistrationNode, WaitsForTheViewsThePlansEndNames) {
   }
   ASSERT_FALSE(report.empty()) << "no registration within 60 s of the plan's end";
   EXPECT_NE(report.find("8 of 8 views registered"), std::string::npos) << report;
+}
+
+/// A message as a subscriber of any type receives it.
+template <typename M>
+void shapeOf(const M& message, topic_tools::ShapeShifter& shape) {
+  const std::uint32_t size = ros::serialization::serializationLength(message);
+  std::vector<std::uint8_t> buffer(size);
+  ros::serialization::OStream out(buffer.data(), size);
+  ros::serialization::serialize(out, message);
+  shape.morph(ros::message_traits::md5sum<M>(), ros::message_traits::datatype<M>(),
+              ros::message_traits::definition<M>(), "");
+  ros::serialization::IStream in(buffer.data(), size);
+  shape.read(in);
+}
+
+TEST(PlanEnd, ReadsTheTypedProgressAndTheTextOfOlderBags) {
+  using dormant_tree_modeling::AcquisitionProgress;
+  topic_tools::ShapeShifter shape;
+  AcquisitionProgress p;
+  p.state = AcquisitionProgress::RUNNING;
+  p.done = 3;
+  shapeOf(p, shape);
+  EXPECT_FALSE(ros_layer::planEnd(shape)) << "a running plan has not ended";
+  p.state = AcquisitionProgress::FINISHED;
+  p.done = 7;
+  shapeOf(p, shape);
+  ASSERT_TRUE(ros_layer::planEnd(shape));
+  EXPECT_EQ(ros_layer::planEnd(shape)->views, 7);
+
+  std_msgs::String text;
+  text.data = "finished: 38 of 40 planned views acquired, 2412 s of scanning.";
+  shapeOf(text, shape);
+  ASSERT_TRUE(ros_layer::planEnd(shape)) << "bags recorded before the progress was typed";
+  EXPECT_EQ(ros_layer::planEnd(shape)->views, 38);
+  text.data = "view 3 of 40";
+  shapeOf(text, shape);
+  EXPECT_FALSE(ros_layer::planEnd(shape));
+
+  std_msgs::Int32 other;
+  shapeOf(other, shape);
+  EXPECT_FALSE(ros_layer::planEnd(shape)) << "another type is no plan's end";
 }
 
 }  // namespace

@@ -12,6 +12,7 @@ namespace acquisition {
 
 /// @brief Where a run is, for the operator.
 struct SequencerProgress {
+  int view = 0;    ///< the view in hand (1-based); 0 before the first
   int done = 0;    ///< views acquired
   int failed = 0;  ///< views given up after their retries
   int total = 0;

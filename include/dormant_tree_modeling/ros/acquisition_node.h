@@ -1,6 +1,7 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dormant_tree_modeling/AcquisitionProgress.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -25,11 +26,11 @@ namespace ros_layer {
 /// `~platform_in_place`, std_srvs/Trigger, by the rviz user or a script), publishes the plan's
 /// platform pose as the tf `orchard -> platform` guess (and, before the move, as the goal
 /// `~platform_goal`, geometry_msgs/PoseStamped, for a driver or the virtual platform's
-/// operator), shows progress on `~progress`
-/// (std_msgs/String: views done, failed, time left), and records the raw topics of the tree into
-/// one rosbag (`~output_dir`/`~tree_name`.bag) with a Markdown report beside it. Services
+/// operator), shows progress on `~progress` (AcquisitionProgress, latched: state, view, views
+/// done, failed and planned, time left, the operator's line), and records the raw topics of the
+/// tree into one rosbag (`~output_dir`/`~tree_name`.bag) with a Markdown report beside it. Services
 /// `~start` and `~cancel`; a cancelled or interrupted run closes the bag, so it stays usable.
-/// The final "finished: ..." progress goes into the bag too, so a replay knows the plan ended.
+/// The final FINISHED progress goes into the bag too, so a replay knows the plan ended.
 /// Diagnostics: state, views done and failed, the bag, the last problem.
 class AcquisitionNode {
  public:
@@ -47,6 +48,10 @@ class AcquisitionNode {
   bool askForPlatform(const acquisition::PlannedView& view);
   void record(const std::string& topic, const topic_tools::ShapeShifter::ConstPtr& msg);
   void publish(ros::Publisher& pub, const std::string& text);
+  static dormant_tree_modeling::AcquisitionProgress progressMessage(
+      std::uint8_t state, const acquisition::SequencerProgress& p, const std::string& text);
+  void publishProgress(std::uint8_t state, const acquisition::SequencerProgress& p,
+                       const std::string& text);
   /// Sends the platform's pose again, stamped now, so that tf has it at every view's time.
   void republishPlatform();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
@@ -82,6 +87,7 @@ class AcquisitionNode {
   bool in_place_ = false;
   std::string state_ = "idle", last_problem_;
   int done_ = 0, failed_ = 0, total_ = 0;
+  acquisition::SequencerProgress last_progress_;  // the run's latest, on its thread only
   std::atomic<bool> cancel_{false}, running_{false};
   std::thread worker_;
 };

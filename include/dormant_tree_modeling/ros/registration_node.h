@@ -7,6 +7,7 @@
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <topic_tools/shape_shifter.h>
 
 #include <mutex>
 #include <optional>
@@ -23,6 +24,16 @@
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
+/// @brief A plan's end as the acquisition reports it.
+struct PlanEnd {
+  std::optional<int> views;  ///< the views it says were acquired, when it says
+};
+
+/// @brief The plan's end in a progress message: the typed AcquisitionProgress in state
+/// FINISHED, or the text "finished: N of M planned views acquired, ..." of bags recorded
+/// before the progress was typed. None for any other progress or type.
+std::optional<PlanEnd> planEnd(const topic_tools::ShapeShifter& msg);
+
 /// @brief ROS wrapper of the multi-view registration.
 ///
 /// Collects `view_cloud`s (PointCloud2, in the platform frame as the scan assembler
@@ -30,7 +41,8 @@ namespace ros_layer {
 /// platform transform (the plan's or the operator's estimate, used only as a hint) did not
 /// change belong to one station; without that transform every view is its own station.
 /// Registers on `~register` (std_srvs/Trigger), when `~expected_views` have arrived, or when
-/// the acquisition reports "finished" on `~plan_progress_topic`, on a worker thread. A
+/// the acquisition reports FINISHED on `~plan_progress_topic` (AcquisitionProgress; the text
+/// "finished: ..." of older bags is read too), on a worker thread. A
 /// "finished" that names more views than have arrived (a replay: the scan assembler is still
 /// assembling the last sweeps) waits up to `~finished_wait` wall-clock seconds for them.
 /// Publishes, latched, `~tree_cloud` (the registered views, frame `~tree_frame` = the first
@@ -50,7 +62,7 @@ class RegistrationNode {
 
  private:
   void viewCallback(const sensor_msgs::PointCloud2ConstPtr& msg);
-  void progressCallback(const std_msgs::StringConstPtr& msg);
+  void progressCallback(const topic_tools::ShapeShifter::ConstPtr& msg);
   /// The plan's end named views that have not arrived within `~finished_wait`.
   void finishedWaitExpired();
   void checkEndOfInput();
