@@ -75,10 +75,8 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
     publishProgress(Progress::IDLE, idle,
                     "idle: " + std::to_string(total_) + " views planned; call ~start");
   }
-  diagnostics_.setHardwareID("none");
   diagnostics_.add("acquisition", this, &AcquisitionNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "none");
   platform_tf_timer_ = nh.createTimer(ros::Duration(1.0 / PLATFORM_TF_HZ),
                                       [this](const ros::TimerEvent&) { republishPlatform(); });
   if (pnh.param("autostart", false)) {

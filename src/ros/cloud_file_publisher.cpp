@@ -36,10 +36,8 @@ CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh
   publisher_ = nh.advertise<sensor_msgs::PointCloud2>("cloud", 1, /*latch=*/true);
   ROS_INFO("publishing %zu points from %s in frame '%s'%s", loaded.cloud->size(), file.c_str(),
            frame_id.c_str(), rate > 0.0 ? "" : " (latched, once)");
-  diagnostics_.setHardwareID("none");
   diagnostics_.add("cloud file", this, &CloudFilePublisher::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "none");
   publish();
   if (rate > 0.0) {
     timer_ =

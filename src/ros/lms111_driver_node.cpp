@@ -51,17 +51,15 @@ Lms111DriverNode::Lms111DriverNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   scan_pub_ = nh.advertise<sensor_msgs::LaserScan>("scan", 10);
 
-  updater_.setHardwareID("LMS111 " + config.host + ":" + std::to_string(config.port));
   expected_rate_ = config.scan_frequency_hz;
   min_rate_ = expected_rate_ * (1.0 - RATE_TOLERANCE);
   max_rate_ = expected_rate_ * (1.0 + RATE_TOLERANCE);
   rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
       diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.0, RATE_WINDOW),
       "scan rate");
-  updater_.add(*rate_);
-  updater_.add("device", this, &Lms111DriverNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  diagnostics_.add(*rate_);
+  diagnostics_.add("device", this, &Lms111DriverNode::diagnose);
+  diagnostics_.start(nh, "LMS111 " + config.host + ":" + std::to_string(config.port));
 
   driver_ = std::make_unique<lms111::Lms111Driver>(
       config, [this](const lms111::StampedScan& s) { publish(s); },

@@ -117,10 +117,8 @@ RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   register_srv_ = pnh.advertiseService("register", &RegistrationNode::registerService, this);
   reset_srv_ = pnh.advertiseService("reset", &RegistrationNode::resetService, this);
 
-  diagnostics_.setHardwareID("none");
   diagnostics_.add("registration", this, &RegistrationNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "none");
   if (end_of_input_timeout_ > 0 && !input_topic.empty()) {
     last_input_ = ros::WallTime::now();
     input_sub_ = nh.subscribe<topic_tools::ShapeShifter>(

@@ -81,10 +81,8 @@ ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) 
   image_pub_ = nh.advertise<sensor_msgs::Image>("range_image", 2, true);
   if (!passive_)
     acquire_srv_ = pnh.advertiseService("acquire_view", &ScanAssemblerNode::acquireView, this);
-  diagnostics_.setHardwareID("none");
   diagnostics_.add("scan assembler", this, &ScanAssemblerNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "none");
   if (passive_)
     ROS_INFO("scan_assembler: passive, assembling the sweeps seen on %s",
              joint_sub_.getTopic().c_str());

@@ -110,10 +110,8 @@ StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& p
   home_srv_ = pnh.advertiseService("home", &StageControllerNode::home, this);
   publishStaticFrames();
   const auto& c = stage_->config().controller;
-  updater_.setHardwareID("Aerotech Ensemble " + c.host + ":" + std::to_string(c.port));
-  updater_.add("stage", this, &StageControllerNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  diagnostics_.add("stage", this, &StageControllerNode::diagnose);
+  diagnostics_.start(nh, "Aerotech Ensemble " + c.host + ":" + std::to_string(c.port));
   setup_thread_ = std::thread([this] { setUpLoop(); });
   feedback_thread_ = std::thread([this] { feedbackLoop(); });
 }

@@ -82,10 +82,8 @@ TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     throw Error(ErrorCode::INVALID_ARGUMENT, "~exit_after_models must be >= 0 (0: never)");
   if (!output_dir_.empty())
     std::filesystem::create_directories(output_dir_);
-  diagnostics_.setHardwareID("none");
   diagnostics_.add("tree modeler", this, &TreeModelerNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "none");
   model_pub_ = nh.advertise<dormant_tree_modeling::TreeModel>("tree_model", 1, true);
   marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
   segments_pub_ = nh.advertise<sensor_msgs::PointCloud2>("segments", 1, true);

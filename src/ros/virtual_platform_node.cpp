@@ -93,10 +93,8 @@ VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& p
                              &VirtualPlatformNode::goalCallback, this);
   }
   place(o.platform, nullptr);
-  diagnostics_.setHardwareID("virtual platform");
   diagnostics_.add("virtual platform", this, &VirtualPlatformNode::diagnose);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_.start(nh, "virtual platform");
   ROS_INFO(
       "virtual_platform: LMS111 on 127.0.0.1:%d (CoLa-A), %d (CoLa-B); Aerotech on "
       "127.0.0.1:%d; %s; platform at %s%s",

@@ -17,6 +17,8 @@
 
 #include "dormant_tree_modeling/acquisition/sequencer.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -67,8 +69,7 @@ class AcquisitionNode {
   double service_wait_s_;  // for the stage's and the assembler's services (start-up)
 
   ros::Publisher prompt_pub_, progress_pub_, goal_pub_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
   ros::ServiceServer start_srv_, cancel_srv_, in_place_srv_;
   std::vector<ros::Subscriber> recorders_;
   /// The plan's pose of the platform, `orchard` -> platform, republished on /tf (not

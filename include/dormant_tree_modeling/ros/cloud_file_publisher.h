@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -31,8 +33,8 @@ class CloudFilePublisher {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::Publisher publisher_;
-  ros::Timer timer_, diagnostics_timer_;
-  diagnostic_updater::Updater diagnostics_;
+  ros::Timer timer_;
+  NodeDiagnostics diagnostics_;
   sensor_msgs::PointCloud2 msg_;
   std::string file_, offset_;
   std::size_t dropped_ = 0, published_ = 0;

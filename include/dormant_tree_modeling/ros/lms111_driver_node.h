@@ -9,6 +9,8 @@
 
 #include "dormant_tree_modeling/lms111/driver.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -38,11 +40,11 @@ class Lms111DriverNode {
   std::string frame_id_;
   double range_min_, range_max_;
   ros::Publisher scan_pub_;
-  diagnostic_updater::Updater updater_;
   double expected_rate_;
   double min_rate_, max_rate_;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_;
-  ros::Timer diagnostics_timer_;
+  // After the rate it reports: destroyed first, so its timer never reads a destroyed rate.
+  NodeDiagnostics diagnostics_;
   std::unique_ptr<lms111::Lms111Driver> driver_;
 };
 

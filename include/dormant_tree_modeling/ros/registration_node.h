@@ -21,6 +21,8 @@
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -93,8 +95,7 @@ class RegistrationNode {
   ros::Subscriber view_sub_, progress_sub_;
   ros::Publisher cloud_pub_, poses_pub_, report_pub_;
   ros::ServiceServer register_srv_, reset_srv_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
   ros::WallTimer finished_timer_, input_timer_;
   double end_of_input_timeout_ = 0.0;  // s without a message on input_sub_'s topic; 0 off
   ros::Subscriber input_sub_;

@@ -18,6 +18,8 @@
 #include "dormant_tree_modeling/acquisition/view_processing.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -82,8 +84,7 @@ class ScanAssemblerNode {
 
   std::unique_ptr<acquisition::SweepRecorder> recorder_;  // scans and stage positions
   std::mutex acquire_mutex_;                              // one sweep at a time
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
 
   bool passive_ = false;
   std::unique_ptr<acquisition::SweepWatcher> watcher_;  // passive: sweeps in joint_states

@@ -15,6 +15,8 @@
 #include "dormant_tree_modeling/aerotech/stage_controller.h"
 #include "dormant_tree_modeling/common/error.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -63,8 +65,7 @@ class StageControllerNode {
   ros::ServiceServer move_srv_, home_srv_;
   tf2_ros::TransformBroadcaster tf_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
-  diagnostic_updater::Updater updater_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
 
   std::atomic<bool> stop_{false}, ready_{false};
   std::mutex status_mutex_;

@@ -15,6 +15,8 @@
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -66,8 +68,7 @@ class TreeModelerNode {
   std::string output_dir_, output_frame_;
   tf2_ros::Buffer tf_buffer_{ros::Duration(TF_CACHE_S)};
   TfFeed tf_feed_{tf_buffer_};
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
   ros::Subscriber cloud_sub_;
   ros::Publisher model_pub_, marker_pub_, segments_pub_;
   ros::ServiceServer model_srv_;

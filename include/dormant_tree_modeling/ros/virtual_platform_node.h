@@ -14,6 +14,8 @@
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/simulation/virtual_platform.h"
 
+#include "dormant_tree_modeling/ros/node_support.h"
+
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
@@ -57,8 +59,7 @@ class VirtualPlatformNode {
   ros::Publisher pose_pub_;
   ros::Subscriber goal_sub_;
   ros::ServiceServer move_srv_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
 
   std::mutex mutex_;
   int goals_ = 0, moves_ = 0;
