@@ -13,6 +13,9 @@ namespace registration {
 
 namespace {
 
+// A fit whose conditioning reaches this leaves no direction free in practice: full confidence.
+constexpr double FULL_CONDITIONING = 0.05;
+
 struct Station {
   int id = 0;
   std::vector<int> views;
@@ -78,6 +81,183 @@ std::string judge(const IcpResult& fit, const RegistrationConfig& c) {
   return "";
 }
 
+/// Stations in order of first appearance, each with its views' indices and the hint of its
+/// first view.
+std::vector<Station> groupStations(const std::vector<ViewInput>& views, bool use_hints) {
+  std::vector<Station> stations;
+  std::map<int, std::size_t> slot;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const auto [it, fresh] = slot.emplace(views[i].station, stations.size());
+    if (fresh) {
+      stations.emplace_back();
+      stations.back().id = views[i].station;
+      if (use_hints)
+        stations.back().hint = views[i].station_hint;
+    }
+    stations[it->second].views.push_back(static_cast<int>(i));
+  }
+  return stations;
+}
+
+/// A station's views merged in its own frame as an ICP pyramid (with the branch axes when
+/// the ICP pairs them); too few points at the finest level leave the station out.
+void prepareStation(Station& s, const std::vector<ViewInput>& views, const RegistrationConfig& c) {
+  Points pts, dirs;
+  std::vector<double> ranges;
+  for (const int i : s.views) {
+    const ViewInput& v = views[i];
+    const Eigen::Vector3d sensor = v.in_station * v.sensor;
+    for (const auto& p : v.points) {
+      if (!p.allFinite())
+        continue;
+      const Eigen::Vector3d q = v.in_station * p;
+      pts.push_back(q);
+      const Eigen::Vector3d d = sensor - q;
+      const double range = d.norm();
+      ranges.push_back(range);
+      dirs.push_back(range > 0 ? Eigen::Vector3d(d / range) : Eigen::Vector3d::Zero());
+    }
+  }
+  s.pyramid = makePyramid(pts, dirs, c.icp.voxels, c.icp.normal_neighbors);
+  if (c.icp.axis_pairs) {
+    // One sample per source point of the finest ICP level (the level above the finest).
+    const std::size_t centres = s.pyramid.levels.size() >= 2 ? s.pyramid.levels.size() - 2 : 0;
+    s.pyramid.axes = estimateAxes(pts, dirs, ranges, s.pyramid.levels[centres].points, c.axes);
+  }
+  if (s.pyramid.levels.back().size() < c.min_points) {
+    s.rejected = true;
+    s.reason = "too few points (" + std::to_string(s.pyramid.levels.back().size()) +
+               " at the finest level, needs " + std::to_string(c.min_points) + ")";
+  }
+}
+
+/// The first station with enough points: the frame the others are placed in.
+/// @throws Error EMPTY_INPUT when there is none
+std::size_t chooseReference(std::vector<Station>& stations) {
+  for (std::size_t k = 0; k < stations.size(); ++k) {
+    if (!stations[k].rejected) {
+      stations[k].placed = true;
+      return k;
+    }
+  }
+  throw Error(ErrorCode::EMPTY_INPUT,
+              "registration: no view holds enough points (" + stations.front().reason + ")");
+}
+
+/// Places a station against everything placed so far: a coarse search (around its hint,
+/// carried into the reference frame by the placed stations' hints), a few ICP levels on each
+/// candidate, and the best by overlap refined on the rest.
+void placeStation(std::vector<Station>& stations, std::size_t k, const RegistrationConfig& c) {
+  Station& s = stations[k];
+  const Pyramid target = othersUnion(stations, k);
+  std::optional<Eigen::Isometry3d> hint;
+  if (s.hint) {
+    if (const auto world = worldInReference(stations))
+      hint = *world * *s.hint;
+  }
+  std::vector<CoarseCandidate> candidates;
+  try {
+    candidates =
+        coarseSearch(s.pyramid.levels.front().points, target.levels.front().points, hint, c.coarse);
+  } catch (const Error& e) {
+    s.rejected = true;
+    s.reason = std::string("coarse search failed: ") + e.what();
+    return;
+  }
+  std::optional<IcpResult> best;
+  for (const auto& cand : candidates) {
+    try {
+      const IcpResult r =
+          alignPyramids(s.pyramid, target, cand.transform, c.icp, 0, c.candidate_levels - 1);
+      if (!best || r.overlap > best->overlap)
+        best = r;
+    } catch (const Error&) {
+      // This candidate left the clouds apart; the others may not.
+    }
+  }
+  if (!best) {
+    s.rejected = true;
+    s.reason = "no candidate pose overlaps the views placed before it";
+    return;
+  }
+  try {
+    s.fit = alignPyramids(s.pyramid, target, best->transform, c.icp, c.candidate_levels);
+    s.pose = s.fit.transform;
+    s.placed = true;
+  } catch (const Error& e) {
+    s.rejected = true;
+    s.reason = std::string("refinement failed: ") + e.what();
+  }
+}
+
+/// One joint round: every placed station against all the others (Gauss-Seidel), on the
+/// finest level only (placement left each near its place); then the stations that do not fit
+/// leave the others' targets. The reference moves too (the frame is fixed afterwards): held
+/// still, it would keep the others bent towards whatever error its first pairing left.
+void refinementRound(std::vector<Station>& stations, std::size_t ref, const RegistrationConfig& c) {
+  const int fine_first = static_cast<int>(c.icp.voxels.size()) - 1;
+  for (std::size_t k = 0; k < stations.size(); ++k) {
+    Station& s = stations[k];
+    if (!s.placed || s.rejected)
+      continue;
+    const Pyramid target = othersUnion(stations, k);
+    if (target.levels.empty()) {
+      s.fit = IcpResult{};
+      s.fit.overlap = 1.0;  // the only station: nothing to contradict it
+      s.fit.conditioning = 1.0;
+      continue;
+    }
+    try {
+      const IcpResult r = alignPyramids(s.pyramid, target, s.pose, c.icp, fine_first);
+      s.fit = r;
+      if (c.refinement_rounds > 0)
+        s.pose = r.transform;
+    } catch (const Error& e) {
+      s.fit = IcpResult{};
+      s.fit.overlap = 0;
+      s.reason = std::string("refinement failed: ") + e.what();
+    }
+  }
+  for (std::size_t k = 0; k < stations.size(); ++k) {
+    Station& s = stations[k];
+    if (!s.placed || s.rejected || k == ref)
+      continue;
+    const std::string why = s.reason.empty() ? judge(s.fit, c) : s.reason;
+    if (!why.empty()) {
+      s.rejected = true;
+      s.reason = why;
+    }
+  }
+}
+
+/// Each view's pose in the first registered view's frame, its station's fit, and why it was
+/// left out.
+RegistrationResult viewResults(const std::vector<ViewInput>& views,
+                               const std::vector<Station>& stations, std::size_t ref) {
+  RegistrationResult out;
+  out.stations = static_cast<int>(stations.size());
+  const Eigen::Isometry3d to_first = views[stations[ref].views.front()].in_station.inverse();
+  out.views.resize(views.size());
+  for (const auto& s : stations) {
+    if (s.placed && !s.rejected)
+      ++out.stations_registered;
+    for (const int i : s.views) {
+      ViewResult& v = out.views[i];
+      v.name = views[i].name;
+      v.station = s.id;
+      v.registered = s.placed && !s.rejected;
+      v.pose = to_first * s.pose * views[i].in_station;
+      v.rmse = s.fit.rmse;
+      v.overlap = s.fit.overlap;
+      v.confidence = v.registered ? std::clamp(s.fit.overlap, 0.0, 1.0) *
+                                        std::min(1.0, s.fit.conditioning / FULL_CONDITIONING)
+                                  : 0.0;
+      v.reason = v.registered ? "" : (s.reason.empty() ? "not placed" : s.reason);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void RegistrationConfig::validate() const {
@@ -99,181 +279,28 @@ void RegistrationConfig::validate() const {
 RegistrationResult registerViews(const std::vector<ViewInput>& views, const RegistrationConfig& c) {
   c.validate();
   const auto t0 = std::chrono::steady_clock::now();
-  if (views.empty())
-    throw Error(ErrorCode::EMPTY_INPUT, "registration: no views");
-
-  // Stations in order of first appearance; each merged in its own frame.
-  std::vector<Station> stations;
-  std::map<int, std::size_t> slot;
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const auto [it, fresh] = slot.emplace(views[i].station, stations.size());
-    if (fresh) {
-      stations.emplace_back();
-      stations.back().id = views[i].station;
-      if (c.use_hints)
-        stations.back().hint = views[i].station_hint;
-    }
-    stations[it->second].views.push_back(static_cast<int>(i));
-  }
-  for (auto& s : stations) {
-    Points pts, dirs;
-    std::vector<double> ranges;
-    for (const int i : s.views) {
-      const ViewInput& v = views[i];
-      const Eigen::Vector3d sensor = v.in_station * v.sensor;
-      for (const auto& p : v.points) {
-        if (!p.allFinite())
-          continue;
-        const Eigen::Vector3d q = v.in_station * p;
-        pts.push_back(q);
-        const Eigen::Vector3d d = sensor - q;
-        const double range = d.norm();
-        ranges.push_back(range);
-        dirs.push_back(range > 0 ? Eigen::Vector3d(d / range) : Eigen::Vector3d::Zero());
-      }
-    }
-    s.pyramid = makePyramid(pts, dirs, c.icp.voxels, c.icp.normal_neighbors);
-    if (c.icp.axis_pairs) {
-      // One sample per source point of the finest ICP level (the level above the finest).
-      const std::size_t centres = s.pyramid.levels.size() >= 2 ? s.pyramid.levels.size() - 2 : 0;
-      s.pyramid.axes = estimateAxes(pts, dirs, ranges, s.pyramid.levels[centres].points, c.axes);
-    }
-    if (s.pyramid.levels.back().size() < c.min_points) {
-      s.rejected = true;
-      s.reason = "too few points (" + std::to_string(s.pyramid.levels.back().size()) +
-                 " at the finest level, needs " + std::to_string(c.min_points) + ")";
-    }
-  }
   const auto since = [&t0] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
+  if (views.empty())
+    throw Error(ErrorCode::EMPTY_INPUT, "registration: no views");
+  std::vector<Station> stations = groupStations(views, c.use_hints);
+  for (auto& s : stations)
+    prepareStation(s, views, c);
   const double t_prepared = since();
-  std::size_t ref = stations.size();
-  for (std::size_t k = 0; k < stations.size() && ref == stations.size(); ++k) {
-    if (!stations[k].rejected)
-      ref = k;
-  }
-  if (ref == stations.size())
-    throw Error(ErrorCode::EMPTY_INPUT,
-                "registration: no view holds enough points (" + stations.front().reason + ")");
-  stations[ref].placed = true;
-
-  // Place each further station against everything placed so far.
+  const std::size_t ref = chooseReference(stations);
   for (std::size_t k = 0; k < stations.size(); ++k) {
-    Station& s = stations[k];
-    if (s.placed || s.rejected)
-      continue;
-    const Pyramid target = othersUnion(stations, k);
-    std::optional<Eigen::Isometry3d> hint;
-    if (s.hint) {
-      if (const auto world = worldInReference(stations))
-        hint = *world * *s.hint;
-    }
-    std::vector<CoarseCandidate> candidates;
-    try {
-      candidates = coarseSearch(s.pyramid.levels.front().points, target.levels.front().points, hint,
-                                c.coarse);
-    } catch (const Error& e) {
-      s.rejected = true;
-      s.reason = std::string("coarse search failed: ") + e.what();
-      continue;
-    }
-    std::optional<IcpResult> best;
-    for (const auto& cand : candidates) {
-      try {
-        const IcpResult r =
-            alignPyramids(s.pyramid, target, cand.transform, c.icp, 0, c.candidate_levels - 1);
-        if (!best || r.overlap > best->overlap)
-          best = r;
-      } catch (const Error&) {
-        // This candidate left the clouds apart; the others may not.
-      }
-    }
-    if (!best) {
-      s.rejected = true;
-      s.reason = "no candidate pose overlaps the views placed before it";
-      continue;
-    }
-    try {
-      s.fit = alignPyramids(s.pyramid, target, best->transform, c.icp, c.candidate_levels);
-      s.pose = s.fit.transform;
-      s.placed = true;
-    } catch (const Error& e) {
-      s.rejected = true;
-      s.reason = std::string("refinement failed: ") + e.what();
-    }
+    if (!stations[k].placed && !stations[k].rejected)
+      placeStation(stations, k, c);
   }
-
-  // Joint rounds: every station against all the others (Gauss-Seidel). Stations that do not
-  // fit after the first round leave the others' targets.
-  // Placement left every station near its place: the joint rounds only need the finest level.
-  const int fine_first = static_cast<int>(c.icp.voxels.size()) - 1;
   const double t_placed = since();
-  for (int round = 0; round < std::max(1, c.refinement_rounds); ++round) {
-    for (std::size_t k = 0; k < stations.size(); ++k) {
-      Station& s = stations[k];
-      if (!s.placed || s.rejected)
-        continue;
-      const Pyramid target = othersUnion(stations, k);
-      if (target.levels.empty()) {
-        s.fit = IcpResult{};
-        s.fit.overlap = 1.0;  // the only station: nothing to contradict it
-        s.fit.conditioning = 1.0;
-        continue;
-      }
-      try {
-        const IcpResult r = alignPyramids(s.pyramid, target, s.pose, c.icp, fine_first);
-        s.fit = r;
-        // The reference moves too (the frame is fixed afterwards): held still, it would keep
-        // the others bent towards whatever error its first pairing left.
-        if (c.refinement_rounds > 0)
-          s.pose = r.transform;
-      } catch (const Error& e) {
-        s.fit = IcpResult{};
-        s.fit.overlap = 0;
-        s.reason = std::string("refinement failed: ") + e.what();
-      }
-    }
-    for (std::size_t k = 0; k < stations.size(); ++k) {
-      Station& s = stations[k];
-      if (!s.placed || s.rejected || k == ref)
-        continue;
-      const std::string why = s.reason.empty() ? judge(s.fit, c) : s.reason;
-      if (!why.empty()) {
-        s.rejected = true;
-        s.reason = why;
-      }
-    }
-  }
-
+  for (int round = 0; round < std::max(1, c.refinement_rounds); ++round)
+    refinementRound(stations, ref, c);
   // Back into the reference station's frame.
   const Eigen::Isometry3d gauge = stations[ref].pose.inverse();
   for (auto& s : stations)
     s.pose = gauge * s.pose;
-
-  // Views: the reference frame is the first registered view's.
-  RegistrationResult out;
-  out.stations = static_cast<int>(stations.size());
-  const Eigen::Isometry3d to_first = views[stations[ref].views.front()].in_station.inverse();
-  out.views.resize(views.size());
-  for (const auto& s : stations) {
-    if (s.placed && !s.rejected)
-      ++out.stations_registered;
-    for (const int i : s.views) {
-      ViewResult& v = out.views[i];
-      v.name = views[i].name;
-      v.station = s.id;
-      v.registered = s.placed && !s.rejected;
-      v.pose = to_first * s.pose * views[i].in_station;
-      v.rmse = s.fit.rmse;
-      v.overlap = s.fit.overlap;
-      // Conditioning of 0.05 and above means no direction is left free in practice.
-      v.confidence = v.registered ? std::clamp(s.fit.overlap, 0.0, 1.0) *
-                                        std::min(1.0, s.fit.conditioning / 0.05)
-                                  : 0.0;
-      v.reason = v.registered ? "" : (s.reason.empty() ? "not placed" : s.reason);
-    }
-  }
+  RegistrationResult out = viewResults(views, stations, ref);
   out.seconds = since();
   out.seconds_prepare = t_prepared;
   out.seconds_placement = t_placed - t_prepared;
