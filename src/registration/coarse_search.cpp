@@ -86,6 +86,222 @@ Eigen::Isometry3d poseOf(double yaw, const Eigen::Vector3d& t) {
   return p;
 }
 
+// The height profiles of the two clouds, in slabs of the target's grid: one slab per bit.
+constexpr int PROFILE_SLABS = 64;
+// Without a hint, the heights tried are the best few matches of the two profiles.
+constexpr std::size_t UNHINTED_HEIGHTS = 3;
+// Headings closer than this many steps to a better one are the same peak.
+constexpr double DISTINCT_HEADING_STEPS = 2.5;
+// Headings kept for the 3-D step, per candidate asked for.
+constexpr int HEADINGS_PER_CANDIDATE = 3;
+// The 3-D step tries the horizontal neighbours half a cell away.
+constexpr double REFINE_XY_SHARE = 0.5;
+
+Eigen::Vector3d mean(const Points& pts) {
+  Eigen::Vector3d m = Eigen::Vector3d::Zero();
+  for (const auto& p : pts)
+    m += p;
+  return m / static_cast<double>(pts.size());
+}
+
+// The target's cells dilated by one (noise, cell edges).
+std::unordered_set<std::uint64_t> dilatedCells(const Points& target, double cell) {
+  std::unordered_set<std::uint64_t> cells3;
+  cells3.reserve(target.size() * 27);
+  for (const auto& p : target) {
+    const std::int64_t x = cellOf(p.x(), cell), y = cellOf(p.y(), cell), z = cellOf(p.z(), cell);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+          cells3.insert(key3(x + dx, y + dy, z + dz));
+  }
+  return cells3;
+}
+
+// Where a heading puts the source before any shift.
+struct Placement {
+  const std::optional<Eigen::Isometry3d>& hint;
+  Eigen::Vector3d source_mean, target_mean;
+
+  // With a hint, the hint's place of the source centroid whatever the heading; without one,
+  // the centroids on each other.
+  Eigen::Vector3d baseTranslation(double yaw) const {
+    const Eigen::Vector3d at = hint ? Eigen::Vector3d(*hint * source_mean) : target_mean;
+    return at - poseOf(yaw, Eigen::Vector3d::Zero()) * source_mean;
+  }
+};
+
+// Around the hint's heading within yaw_window_deg, or a full turn without a hint.
+std::vector<double> headingsToTry(const std::optional<Eigen::Isometry3d>& hint,
+                                  const CoarseSearchConfig& c) {
+  double yaw0 = 0, window = M_PI;
+  if (hint) {
+    yaw0 = std::atan2(hint->linear()(1, 0), hint->linear()(0, 0));
+    window = c.yaw_window_deg * DEG;
+  }
+  const int steps = std::max(0, static_cast<int>(std::floor(window / (c.yaw_step_deg * DEG))));
+  std::vector<double> yaws;
+  for (int k = -steps; k <= steps; ++k) {
+    if (!hint && k == steps && 2 * steps * c.yaw_step_deg >= 360.0 - 1e-9)
+      continue;  // a full turn: -180 and +180 are one heading
+    yaws.push_back(yaw0 + k * c.yaw_step_deg * DEG);
+  }
+  return yaws;
+}
+
+// Height shifts (in slabs) to try: none with a hint (its height is good to a slab; the 3-D
+// step refines it); without one, the best matches of the two height profiles.
+std::vector<int> heightShifts(const Points& source, const Points& target, const Columns& grid,
+                              const Placement& placement, const CoarseSearchConfig& c) {
+  if (placement.hint)
+    return {0};
+  const double base_z = placement.target_mean.z() - placement.source_mean.z();
+  std::vector<double> src(PROFILE_SLABS, 0.0), tgt(PROFILE_SLABS, 0.0);
+  for (const auto& p : source) {
+    const int k = grid.slabOf(p.z() + base_z);
+    if (k >= 0 && k < PROFILE_SLABS)
+      src[k] += 1;
+  }
+  for (const auto& p : target) {
+    const int k = grid.slabOf(p.z());
+    if (k >= 0 && k < PROFILE_SLABS)
+      tgt[k] += 1;
+  }
+  const int zmax = static_cast<int>(std::ceil(c.z_window_unhinted / grid.slab));
+  std::vector<std::pair<double, int>> corr;
+  for (int dz = -zmax; dz <= zmax; ++dz) {
+    double sum = 0;
+    for (int k = 0; k < PROFILE_SLABS; ++k) {
+      if (k + dz >= 0 && k + dz < PROFILE_SLABS)
+        sum += std::min(src[k], tgt[k + dz]);
+    }
+    corr.emplace_back(-sum, dz);
+  }
+  std::sort(corr.begin(), corr.end());
+  std::vector<int> dzs;
+  for (std::size_t i = 0; i < corr.size() && dzs.size() < UNHINTED_HEIGHTS; ++i)
+    dzs.push_back(corr[i].second);
+  return dzs;
+}
+
+// The source's columns at one pose: their cells and a bit per occupied slab of the target's
+// grid.
+struct SourceColumns {
+  std::vector<std::pair<std::int64_t, std::int64_t>> cells;
+  std::vector<std::uint64_t> bits;
+  int occupied = 0;  // slab bits set
+};
+
+SourceColumns sourceColumns(const Points& source, const Columns& grid,
+                            const Eigen::Isometry3d& pose, double cell) {
+  SourceColumns out;
+  std::unordered_map<std::uint64_t, std::size_t> slot;
+  for (const auto& p : source) {
+    const Eigen::Vector3d q = pose * p;
+    const std::int64_t x = cellOf(q.x(), cell), y = cellOf(q.y(), cell);
+    const auto [it, fresh] = slot.emplace(key3(x, y, 0), out.cells.size());
+    if (fresh) {
+      out.cells.emplace_back(x, y);
+      out.bits.push_back(0);
+    }
+    const std::uint64_t b = slabBit(grid.slabOf(q.z()));
+    if (!(out.bits[it->second] & b))
+      ++out.occupied;
+    out.bits[it->second] |= b;
+  }
+  return out;
+}
+
+// The horizontal shift (within xy_window, at each height shift) whose source columns hit the
+// target's most; ties go to the smaller shift (nearer the hint).
+Shift bestShift(const Points& source, const Columns& grid, double yaw, const Eigen::Vector3d& base,
+                const std::vector<int>& dzs, const CoarseSearchConfig& c) {
+  const Eigen::Isometry3d pose = poseOf(yaw, base);
+  const SourceColumns cols = sourceColumns(source, grid, pose, c.cell);
+  const int w = static_cast<int>(std::ceil(c.xy_window / c.cell));
+  Shift s;
+  s.yaw = yaw;
+  for (const int dz : dzs) {
+    std::vector<std::uint64_t> shifted(cols.bits.size());
+    for (std::size_t i = 0; i < cols.bits.size(); ++i)
+      shifted[i] = dz >= 0 ? cols.bits[i] << dz : cols.bits[i] >> -dz;
+    for (int dy = -w; dy <= w; ++dy) {
+      for (int dx = -w; dx <= w; ++dx) {
+        int hits = 0;
+        for (std::size_t i = 0; i < cols.cells.size(); ++i)
+          hits += __builtin_popcountll(
+              shifted[i] & grid.at(cols.cells[i].first + dx, cols.cells[i].second + dy));
+        const double score = static_cast<double>(hits) / std::max(cols.occupied, 1);
+        if (score > s.score ||
+            (score == s.score &&
+             dx * dx + dy * dy < s.translation.head<2>().squaredNorm() / (c.cell * c.cell))) {
+          s.score = score;
+          s.translation = Eigen::Vector3d(dx * c.cell, dy * c.cell, dz * grid.slab);
+        }
+      }
+    }
+  }
+  s.translation += pose.translation();
+  return s;
+}
+
+// The best headings that are local maxima over the heading: a heading within
+// DISTINCT_HEADING_STEPS of a better one is the same peak.
+std::vector<Shift> distinctHeadings(const std::vector<Shift>& best, const CoarseSearchConfig& c) {
+  std::vector<int> order(best.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    order[k] = static_cast<int>(k);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return best[a].score > best[b].score; });
+  std::vector<Shift> picked;
+  for (const int k : order) {
+    bool distinct = true;
+    for (const auto& p : picked) {
+      const double d = std::abs(std::remainder(p.yaw - best[k].yaw, 2 * M_PI));
+      if (d < DISTINCT_HEADING_STEPS * c.yaw_step_deg * DEG)
+        distinct = false;
+    }
+    if (distinct)
+      picked.push_back(best[k]);
+    if (static_cast<int>(picked.size()) >= HEADINGS_PER_CANDIDATE * c.candidates)
+      break;
+  }
+  return picked;
+}
+
+// A heading's pose refined in 3-D: the height within z_window and half a cell around, scored
+// by the share of source points in the target's dilated cells.
+CoarseCandidate refineIn3d(const Points& source, const std::unordered_set<std::uint64_t>& cells3,
+                           const Shift& shift, const CoarseSearchConfig& c) {
+  const int zs = static_cast<int>(std::ceil(c.z_window / c.z_step));
+  const Eigen::Isometry3d pose = poseOf(shift.yaw, shift.translation);
+  Points moved;
+  moved.reserve(source.size());
+  for (const auto& p : source)
+    moved.push_back(pose * p);
+  CoarseCandidate best;
+  for (int iz = -zs; iz <= zs; ++iz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Eigen::Vector3d d(dx * c.cell * REFINE_XY_SHARE, dy * c.cell * REFINE_XY_SHARE,
+                                iz * c.z_step);
+        int hits = 0;
+        for (const auto& q : moved) {
+          const Eigen::Vector3d r = q + d;
+          hits += cells3.count(
+              key3(cellOf(r.x(), c.cell), cellOf(r.y(), c.cell), cellOf(r.z(), c.cell)));
+        }
+        const double score = static_cast<double>(hits) / moved.size();
+        if (score > best.score) {
+          best.score = score;
+          best.transform = poseOf(shift.yaw, shift.translation + d);
+        }
+      }
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 void CoarseSearchConfig::validate() const {
@@ -110,177 +326,21 @@ std::vector<CoarseCandidate> coarseSearch(const Points& source_in, const Points&
   if (source.empty() || target.empty())
     throw Error(ErrorCode::EMPTY_INPUT, "coarse search: a cloud is empty");
   const Columns grid = columns(target, c.cell, 2 * c.cell);
-  std::unordered_set<std::uint64_t> cells3;  // target cells dilated by one (noise, cell edges)
-  cells3.reserve(target.size() * 27);
-  for (const auto& p : target) {
-    const std::int64_t x = cellOf(p.x(), c.cell), y = cellOf(p.y(), c.cell),
-                       z = cellOf(p.z(), c.cell);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz)
-          cells3.insert(key3(x + dx, y + dy, z + dz));
-  }
+  const std::unordered_set<std::uint64_t> cells3 = dilatedCells(target, c.cell);
+  const Placement placement{hint, mean(source), mean(target)};
+  const std::vector<double> yaws = headingsToTry(hint, c);
+  const std::vector<int> dzs = heightShifts(source, target, grid, placement, c);
 
-  // The headings to try, and the base translation of each.
-  Eigen::Vector3d source_mean = Eigen::Vector3d::Zero(), target_mean = Eigen::Vector3d::Zero();
-  for (const auto& p : source)
-    source_mean += p;
-  for (const auto& p : target)
-    target_mean += p;
-  source_mean /= static_cast<double>(source.size());
-  target_mean /= static_cast<double>(target.size());
-  double yaw0 = 0, window = M_PI;
-  if (hint) {
-    yaw0 = std::atan2(hint->linear()(1, 0), hint->linear()(0, 0));
-    window = c.yaw_window_deg * DEG;
-  }
-  const int steps = std::max(0, static_cast<int>(std::floor(window / (c.yaw_step_deg * DEG))));
-  std::vector<double> yaws;
-  for (int k = -steps; k <= steps; ++k) {
-    if (!hint && k == steps && 2 * steps * c.yaw_step_deg >= 360.0 - 1e-9)
-      continue;  // a full turn: -180 and +180 are one heading
-    yaws.push_back(yaw0 + k * c.yaw_step_deg * DEG);
-  }
-  auto baseTranslation = [&](double yaw) -> Eigen::Vector3d {
-    if (hint) {
-      // Keep the hint's translation for the source centroid, whatever the heading.
-      const Eigen::Vector3d at = *hint * source_mean;
-      return at - poseOf(yaw, Eigen::Vector3d::Zero()) * source_mean;
-    }
-    return target_mean - poseOf(yaw, Eigen::Vector3d::Zero()) * source_mean;
-  };
-
-  // Height shifts (in slabs) to try: none with a hint (its height is good to a slab; the 3-D
-  // step below refines it); without one, the best matches of the two height profiles.
-  std::vector<int> dzs = {0};
-  if (!hint) {
-    const double base_z = target_mean.z() - source_mean.z();
-    std::vector<double> src(64, 0.0), tgt(64, 0.0);
-    for (const auto& p : source) {
-      const int k = grid.slabOf(p.z() + base_z);
-      if (k >= 0 && k < 64)
-        src[k] += 1;
-    }
-    for (const auto& p : target) {
-      const int k = grid.slabOf(p.z());
-      if (k >= 0 && k < 64)
-        tgt[k] += 1;
-    }
-    const int zmax = static_cast<int>(std::ceil(c.z_window_unhinted / grid.slab));
-    std::vector<std::pair<double, int>> corr;
-    for (int dz = -zmax; dz <= zmax; ++dz) {
-      double sum = 0;
-      for (int k = 0; k < 64; ++k) {
-        if (k + dz >= 0 && k + dz < 64)
-          sum += std::min(src[k], tgt[k + dz]);
-      }
-      corr.emplace_back(-sum, dz);
-    }
-    std::sort(corr.begin(), corr.end());
-    dzs.clear();
-    for (std::size_t i = 0; i < corr.size() && dzs.size() < 3; ++i)
-      dzs.push_back(corr[i].second);
-  }
-
-  // Top-down: best horizontal shift per heading.
-  const int w = static_cast<int>(std::ceil(c.xy_window / c.cell));
+  // Top-down: the best horizontal shift per heading.
   std::vector<Shift> best(yaws.size());
   parallelFor(static_cast<int>(yaws.size()), [&](int k) {
-    const Eigen::Isometry3d pose = poseOf(yaws[k], baseTranslation(yaws[k]));
-    // The source's columns: cell and slab bits (slabs of the target's grid).
-    std::unordered_map<std::uint64_t, std::size_t> slot;
-    std::vector<std::pair<std::int64_t, std::int64_t>> cells;
-    std::vector<std::uint64_t> bits;
-    int occupied = 0;
-    for (const auto& p : source) {
-      const Eigen::Vector3d q = pose * p;
-      const std::int64_t x = cellOf(q.x(), c.cell), y = cellOf(q.y(), c.cell);
-      const auto [it, fresh] = slot.emplace(key3(x, y, 0), cells.size());
-      if (fresh) {
-        cells.emplace_back(x, y);
-        bits.push_back(0);
-      }
-      const std::uint64_t b = slabBit(grid.slabOf(q.z()));
-      if (!(bits[it->second] & b))
-        ++occupied;
-      bits[it->second] |= b;
-    }
-    Shift s;
-    s.yaw = yaws[k];
-    for (const int dz : dzs) {
-      std::vector<std::uint64_t> shifted(bits.size());
-      for (std::size_t i = 0; i < bits.size(); ++i)
-        shifted[i] = dz >= 0 ? bits[i] << dz : bits[i] >> -dz;
-      for (int dy = -w; dy <= w; ++dy) {
-        for (int dx = -w; dx <= w; ++dx) {
-          int hits = 0;
-          for (std::size_t i = 0; i < cells.size(); ++i)
-            hits += __builtin_popcountll(shifted[i] &
-                                         grid.at(cells[i].first + dx, cells[i].second + dy));
-          // Ties go to the smaller shift (nearer the hint).
-          const double score = static_cast<double>(hits) / std::max(occupied, 1);
-          if (score > s.score ||
-              (score == s.score &&
-               dx * dx + dy * dy < s.translation.head<2>().squaredNorm() / (c.cell * c.cell))) {
-            s.score = score;
-            s.translation = Eigen::Vector3d(dx * c.cell, dy * c.cell, dz * grid.slab);
-          }
-        }
-      }
-    }
-    s.translation += pose.translation();
-    best[k] = s;
+    best[k] = bestShift(source, grid, yaws[k], placement.baseTranslation(yaws[k]), dzs, c);
   });
-
-  // The best headings (local maxima over the heading), then the height in 3-D.
-  std::vector<int> order(yaws.size());
-  for (std::size_t k = 0; k < order.size(); ++k)
-    order[k] = static_cast<int>(k);
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return best[a].score > best[b].score; });
-  std::vector<Shift> picked;
-  for (const int k : order) {
-    bool distinct = true;
-    for (const auto& p : picked) {
-      const double d = std::abs(std::remainder(p.yaw - best[k].yaw, 2 * M_PI));
-      if (d < 2.5 * c.yaw_step_deg * DEG)
-        distinct = false;
-    }
-    if (distinct)
-      picked.push_back(best[k]);
-    if (static_cast<int>(picked.size()) >= 3 * c.candidates)
-      break;
-  }
-  const double zw = c.z_window;
-  const int zs = static_cast<int>(std::ceil(zw / c.z_step));
+  // The best headings, then the height in 3-D.
+  const std::vector<Shift> picked = distinctHeadings(best, c);
   std::vector<CoarseCandidate> out(picked.size());
-  parallelFor(static_cast<int>(picked.size()), [&](int k) {
-    const Eigen::Isometry3d pose = poseOf(picked[k].yaw, picked[k].translation);
-    Points moved;
-    moved.reserve(source.size());
-    for (const auto& p : source)
-      moved.push_back(pose * p);
-    CoarseCandidate bestc;
-    for (int iz = -zs; iz <= zs; ++iz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const Eigen::Vector3d d(dx * c.cell * 0.5, dy * c.cell * 0.5, iz * c.z_step);
-          int hits = 0;
-          for (const auto& q : moved) {
-            const Eigen::Vector3d r = q + d;
-            hits += cells3.count(
-                key3(cellOf(r.x(), c.cell), cellOf(r.y(), c.cell), cellOf(r.z(), c.cell)));
-          }
-          const double score = static_cast<double>(hits) / moved.size();
-          if (score > bestc.score) {
-            bestc.score = score;
-            bestc.transform = poseOf(picked[k].yaw, picked[k].translation + d);
-          }
-        }
-      }
-    }
-    out[k] = bestc;
-  });
+  parallelFor(static_cast<int>(picked.size()),
+              [&](int k) { out[k] = refineIn3d(source, cells3, picked[k], c); });
   std::sort(out.begin(), out.end(),
             [](const CoarseCandidate& a, const CoarseCandidate& b) { return a.score > b.score; });
   if (static_cast<int>(out.size()) > c.candidates)
