@@ -68,6 +68,243 @@ void planeBasis(const Eigen::Vector3d& d, Eigen::Vector3d& u, Eigen::Vector3d& v
   v = d.cross(u);
 }
 
+// ICP needs this many points in each cloud, and this many pairs in each iteration.
+constexpr std::size_t MIN_POINTS = 10;
+constexpr std::size_t MIN_PAIRS = 10;
+// Steps within this many times the convergence limits, this many in a row, are a cycle
+// between two near-equal poses: as converged as hard nearest-neighbour pairs get.
+constexpr double CYCLE_STEP_FACTOR = 10.0;
+constexpr int CYCLE_STEPS = 4;
+
+// One pyramid level's clouds and what pairs them.
+struct LevelPair {
+  const Surface& source;
+  const Surface& target;
+  const modeling::PointIndex& index;  // of the target
+  const AxisSamples& source_axes;
+  const AxisSamples& target_axes;
+  const modeling::PointIndex* axis_index;  // of the target's axes; null: no axis pairs
+  double limit;                            // m: farther pairs are no pairs
+};
+
+// The pairs of one iteration, trimmed, and the share of source points close to the target.
+struct Pairs {
+  std::vector<Match> used;
+  std::vector<AxisMatch> axes;
+  double overlap = 0;
+};
+
+// Each source point with its nearest target point: point-to-plane, or point-to-ray when the
+// two were seen from opposite sides.
+void matchPoints(const LevelPair& L, const Eigen::Isometry3d& t, const IcpConfig& c,
+                 std::vector<Match>& matches, std::vector<char>& valid) {
+  const Eigen::Matrix3d rot = t.linear();
+  parallelFor(static_cast<int>(L.source.size()), [&](int i) {
+    valid[i] = 0;
+    const Eigen::Vector3d p = t * L.source.points[i];
+    const int j = L.index.nearestOne(p);
+    if (j < 0)
+      return;
+    const Eigen::Vector3d& n = L.target.normals[j];
+    if (n.isZero())
+      return;
+    const Eigen::Vector3d d = p - L.target.points[j];
+    if (d.squaredNorm() > L.limit * L.limit)
+      return;
+    const Eigen::Vector3d& vt = L.target.view_dirs[j];
+    const bool across = !vt.isZero() && !L.source.view_dirs[i].isZero() &&
+                        (rot * L.source.view_dirs[i]).dot(vt) < c.across_cos;
+    const double ray_gap = across ? (d - d.dot(vt) * vt).norm() : 0.0;
+    matches[i] = {i, j, across ? ray_gap : d.dot(n), across ? ray_gap : d.norm(), across};
+    valid[i] = 1;
+  });
+}
+
+// The pairs an iteration uses: the point pairs (without the opposite-side ones when axis pairs
+// say where the branches are) and the axis pairs, each kept to its `trim` share of the closest.
+Pairs pairUp(const LevelPair& L, const Eigen::Isometry3d& t, const IcpConfig& c,
+             std::vector<Match>& matches, std::vector<char>& valid) {
+  matchPoints(L, t, c, matches, valid);
+  Pairs pairs;
+  std::size_t close = 0;
+  for (std::size_t i = 0; i < L.source.size(); ++i) {
+    if (!valid[i])
+      continue;
+    close += matches[i].gap <= c.overlap_distance;
+    if (!(L.axis_index && matches[i].across))
+      pairs.used.push_back(matches[i]);
+  }
+  pairs.overlap = static_cast<double>(close) / L.source.size();
+  if (L.axis_index) {
+    pairs.axes = matchAxes(L.source_axes, L.target_axes, *L.axis_index, t, L.limit, c);
+    const std::size_t axis_keep = static_cast<std::size_t>(c.trim * pairs.axes.size());
+    if (axis_keep < pairs.axes.size()) {
+      std::nth_element(pairs.axes.begin(), pairs.axes.begin() + axis_keep, pairs.axes.end(),
+                       [](const AxisMatch& a, const AxisMatch& b) { return a.gap < b.gap; });
+      pairs.axes.resize(axis_keep);
+    }
+  }
+  return pairs;
+}
+
+// Keeps the `trim` share (at least MIN_PAIRS) of the point pairs with the smallest residuals.
+void trimPairs(std::vector<Match>& used, double trim) {
+  const std::size_t keep =
+      std::min(used.size(), std::max(MIN_PAIRS, static_cast<std::size_t>(trim * used.size())));
+  if (keep > 0) {
+    std::nth_element(
+        used.begin(), used.begin() + (keep - 1), used.end(),
+        [](const Match& a, const Match& b) { return std::abs(a.residual) < std::abs(b.residual); });
+  }
+  used.resize(keep);
+}
+
+// The linearised point-to-plane system in a small rotation w and translation t, Huber-weighted.
+struct NormalEquations {
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+
+  // One row: residual e along unit n at the centred point p, weight w.
+  void addRow(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double e, double w) {
+    Eigen::Matrix<double, 6, 1> J;
+    J << p.cross(n), n;
+    A += w * J * J.transpose();
+    b -= w * J * e;
+  }
+  // The offset d counted only across a line of direction dir (a ray, a branch axis).
+  void addAcross(const Eigen::Vector3d& p, const Eigen::Vector3d& dir, const Eigen::Vector3d& d,
+                 double w) {
+    Eigen::Vector3d u, v;
+    planeBasis(dir, u, v);
+    addRow(p, u, d.dot(u), w);
+    addRow(p, v, d.dot(v), w);
+  }
+};
+
+// One Gauss-Newton step of a level: the system about the pairs' centroid (so rotation and
+// translation stay on one scale), its rmse and conditioning, and the step it solves to.
+struct Step {
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 1> x;
+  double rmse = 0, conditioning = 0;
+};
+
+Eigen::Vector3d pairCentroid(const LevelPair& L, const Pairs& pairs, const Eigen::Isometry3d& t) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& m : pairs.used)
+    centre += t * L.source.points[m.source];
+  for (const auto& m : pairs.axes)
+    centre += t * L.source_axes.points[m.source];
+  return centre / static_cast<double>(pairs.used.size() + pairs.axes.size());
+}
+
+Step solveStep(const LevelPair& L, const Pairs& pairs, const Eigen::Isometry3d& t,
+               const IcpConfig& c) {
+  const double n_pairs = static_cast<double>(pairs.used.size() + pairs.axes.size());
+  const Eigen::Vector3d centre = pairCentroid(L, pairs, t);
+  const auto huberWeight = [&](double e) {
+    return std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
+  };
+  NormalEquations eq;
+  double sq = 0, radius_sq = 0;
+  for (const auto& m : pairs.used) {
+    const Eigen::Vector3d q = t * L.source.points[m.source];
+    const Eigen::Vector3d p = q - centre;
+    radius_sq += p.squaredNorm();
+    const double w = huberWeight(m.residual);
+    sq += m.residual * m.residual;
+    if (!m.across) {
+      eq.addRow(p, L.target.normals[m.target], m.residual, w);
+      continue;
+    }
+    // Seen from opposite sides, the two points lie on opposite halves of a branch: only the
+    // offset across the target's ray says how far apart the branch axes are.
+    eq.addAcross(p, L.target.view_dirs[m.target], q - L.target.points[m.target], w);
+  }
+  for (const auto& m : pairs.axes) {
+    const Eigen::Vector3d q = t * L.source_axes.points[m.source];
+    radius_sq += (q - centre).squaredNorm();
+    sq += m.gap * m.gap;
+    eq.addAcross(q - centre, L.target_axes.directions[m.target], q - L.target_axes.points[m.target],
+                 huberWeight(m.gap));
+  }
+  Step step;
+  step.rmse = std::sqrt(sq / n_pairs);
+  // Rotation rows scaled by the cloud's radius so both blocks are lengths.
+  const double scale = std::sqrt(radius_sq / n_pairs);
+  Eigen::Matrix<double, 6, 1> s;
+  s << Eigen::Vector3d::Constant(1.0 / std::max(scale, 1e-6)), Eigen::Vector3d::Ones();
+  const Eigen::Matrix<double, 6, 6> An = s.asDiagonal() * eq.A * s.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(An);
+  step.conditioning = es.eigenvalues()(0) / std::max(es.eigenvalues()(5), 1e-12);
+  step.x = eq.A.ldlt().solve(eq.b);
+  const double angle = step.x.head<3>().norm();
+  if (angle > 0)
+    step.transform.linear() = Eigen::AngleAxisd(angle, step.x.head<3>() / angle).toRotationMatrix();
+  step.transform.translation() = centre - step.transform.linear() * centre + step.x.tail<3>();
+  return step;
+}
+
+// Point-to-plane ICP on one level, from r.transform; the source one level coarser than the
+// target: a sparser source costs fewer searches and its averaged points are less noisy, the
+// dense target keeps the planes sharp.
+void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, int level,
+                const IcpConfig& c) {
+  const int levels = static_cast<int>(c.voxels.size());
+  const Surface& source = source_p.levels[std::max(level - 1, 0)];
+  const Surface& target = target_p.levels[level];
+  if (source.size() < MIN_POINTS || target.size() < MIN_POINTS)
+    throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
+  const modeling::PointIndex index(target.points);
+  // Axis pairs only where the estimates are meant to be read: at the finest level.
+  const bool use_axes = c.axis_pairs && level == levels - 1 && !source_p.axes.points.empty() &&
+                        !target_p.axes.points.empty();
+  std::optional<modeling::PointIndex> axis_index;
+  if (use_axes)
+    axis_index.emplace(target_p.axes.points);
+  const LevelPair L{source,
+                    target,
+                    index,
+                    source_p.axes,
+                    target_p.axes,
+                    axis_index ? &*axis_index : nullptr,
+                    c.distance_factor * c.voxels[level]};
+  std::vector<Match> matches(source.size());
+  std::vector<char> valid(source.size());
+  r.converged = false;
+  int small_steps = 0;
+  // Coarse levels only have to hand over to the next: their steps scale with the voxel.
+  const double scale = c.voxels[level] / c.voxels.back();
+  for (int it = 0; it < c.max_iterations; ++it) {
+    ++r.iterations;
+    Pairs pairs = pairUp(L, r.transform, c, matches, valid);
+    r.overlap = pairs.overlap;
+    if (pairs.used.size() + pairs.axes.size() < MIN_PAIRS)
+      throw Error(ErrorCode::EMPTY_INPUT, "ICP: the clouds do not overlap at the guess");
+    trimPairs(pairs.used, c.trim);
+    const Step step = solveStep(L, pairs, r.transform, c);
+    r.rmse = step.rmse;
+    r.conditioning = step.conditioning;
+    if (!step.x.allFinite())
+      break;
+    r.transform = step.transform * r.transform;
+    const double angle = step.x.head<3>().norm();
+    const double shift = step.x.tail<3>().norm();
+    if (angle < scale * c.min_rotation_step * DEG && shift < scale * c.min_translation_step) {
+      r.converged = true;
+      break;
+    }
+    small_steps = angle < CYCLE_STEP_FACTOR * scale * c.min_rotation_step * DEG &&
+                          shift < CYCLE_STEP_FACTOR * scale * c.min_translation_step
+                      ? small_steps + 1
+                      : 0;
+    if (small_steps >= CYCLE_STEPS) {
+      r.converged = true;
+      break;
+    }
+  }
+}
+
 }  // namespace
 
 void IcpConfig::validate() const {
@@ -102,169 +339,8 @@ IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
   first_level = std::clamp(first_level, 0, last_level);
   IcpResult r;
   r.transform = guess;
-  for (int level = first_level; level <= last_level; ++level) {
-    // The source one level coarser than the target: a sparser source costs fewer searches and
-    // its averaged points are less noisy; the dense target keeps the planes sharp.
-    const Surface& source = source_p.levels[std::max(level - 1, 0)];
-    const Surface& target = target_p.levels[level];
-    if (source.size() < 10 || target.size() < 10)
-      throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
-    const modeling::PointIndex index(target.points);
-    const double limit = c.distance_factor * c.voxels[level];
-    // Axis pairs only where the estimates are meant to be read: at the finest level.
-    const bool use_axes = c.axis_pairs && level == levels - 1 && !source_p.axes.points.empty() &&
-                          !target_p.axes.points.empty();
-    std::optional<modeling::PointIndex> axis_index;
-    if (use_axes)
-      axis_index.emplace(target_p.axes.points);
-    std::vector<Match> matches(source.size());
-    std::vector<char> valid(source.size());
-    r.converged = false;
-    int small_steps = 0;
-    for (int it = 0; it < c.max_iterations; ++it) {
-      ++r.iterations;
-      const Eigen::Matrix3d rot = r.transform.linear();
-      parallelFor(static_cast<int>(source.size()), [&](int i) {
-        valid[i] = 0;
-        const Eigen::Vector3d p = r.transform * source.points[i];
-        const int j = index.nearestOne(p);
-        if (j < 0)
-          return;
-        const Eigen::Vector3d& n = target.normals[j];
-        if (n.isZero())
-          return;
-        const Eigen::Vector3d d = p - target.points[j];
-        if (d.squaredNorm() > limit * limit)
-          return;
-        const Eigen::Vector3d& vt = target.view_dirs[j];
-        const bool across = !vt.isZero() && !source.view_dirs[i].isZero() &&
-                            (rot * source.view_dirs[i]).dot(vt) < c.across_cos;
-        const double ray_gap = across ? (d - d.dot(vt) * vt).norm() : 0.0;
-        matches[i] = {i, j, across ? ray_gap : d.dot(n), across ? ray_gap : d.norm(), across};
-        valid[i] = 1;
-      });
-      std::vector<Match> used;
-      std::size_t close = 0;
-      for (std::size_t i = 0; i < source.size(); ++i) {
-        if (!valid[i])
-          continue;
-        close += matches[i].gap <= c.overlap_distance;
-        // With axis pairs, opposite halves say where the branch is through its axes only.
-        if (!(use_axes && matches[i].across))
-          used.push_back(matches[i]);
-      }
-      r.overlap = static_cast<double>(close) / source.size();
-      std::vector<AxisMatch> axis_used;
-      if (use_axes) {
-        axis_used = matchAxes(source_p.axes, target_p.axes, *axis_index, r.transform, limit, c);
-        const std::size_t axis_keep = static_cast<std::size_t>(c.trim * axis_used.size());
-        if (axis_keep < axis_used.size()) {
-          std::nth_element(axis_used.begin(), axis_used.begin() + axis_keep, axis_used.end(),
-                           [](const AxisMatch& a, const AxisMatch& b) { return a.gap < b.gap; });
-          axis_used.resize(axis_keep);
-        }
-      }
-      if (used.size() + axis_used.size() < 10)
-        throw Error(ErrorCode::EMPTY_INPUT, "ICP: the clouds do not overlap at the guess");
-      const std::size_t keep = std::min(
-          used.size(), std::max<std::size_t>(10, static_cast<std::size_t>(c.trim * used.size())));
-      if (keep > 0) {
-        std::nth_element(used.begin(), used.begin() + (keep - 1), used.end(),
-                         [](const Match& a, const Match& b) {
-                           return std::abs(a.residual) < std::abs(b.residual);
-                         });
-      }
-      used.resize(keep);
-      // Linearised point-to-plane step (small rotation w, translation t), Huber-weighted.
-      Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
-      Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
-      // Rotations about the matched points' centroid keep the two halves of the system on
-      // one scale (the conditioning measure needs that).
-      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-      for (const auto& m : used)
-        centre += r.transform * source.points[m.source];
-      for (const auto& m : axis_used)
-        centre += r.transform * source_p.axes.points[m.source];
-      const double pairs = static_cast<double>(used.size() + axis_used.size());
-      centre /= pairs;
-      // One linearised row: residual e along unit n at the centred point p, weight w.
-      auto addRow = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n, double e, double w) {
-        Eigen::Matrix<double, 6, 1> J;
-        J << p.cross(n), n;
-        A += w * J * J.transpose();
-        b -= w * J * e;
-      };
-      // The offset d counted only across a line of direction dir (a ray, a branch axis).
-      auto addAcross = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& dir,
-                           const Eigen::Vector3d& d, double w) {
-        Eigen::Vector3d u, v;
-        planeBasis(dir, u, v);
-        addRow(p, u, d.dot(u), w);
-        addRow(p, v, d.dot(v), w);
-      };
-      auto huberWeight = [&](double e) {
-        return std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
-      };
-      double sq = 0, radius_sq = 0;
-      for (const auto& m : used) {
-        const Eigen::Vector3d q = r.transform * source.points[m.source];
-        const Eigen::Vector3d p = q - centre;
-        radius_sq += p.squaredNorm();
-        const double w = huberWeight(m.residual);
-        sq += m.residual * m.residual;
-        if (!m.across) {
-          addRow(p, target.normals[m.target], m.residual, w);
-          continue;
-        }
-        // Seen from opposite sides, the two points lie on opposite halves of a branch: only
-        // the offset across the target's ray says how far apart the branch axes are.
-        addAcross(p, target.view_dirs[m.target], q - target.points[m.target], w);
-      }
-      for (const auto& m : axis_used) {
-        const Eigen::Vector3d q = r.transform * source_p.axes.points[m.source];
-        radius_sq += (q - centre).squaredNorm();
-        sq += m.gap * m.gap;
-        addAcross(q - centre, target_p.axes.directions[m.target],
-                  q - target_p.axes.points[m.target], huberWeight(m.gap));
-      }
-      r.rmse = std::sqrt(sq / pairs);
-      {
-        // Rotation rows scaled by the cloud's radius so both blocks are lengths.
-        const double scale = std::sqrt(radius_sq / pairs);
-        Eigen::Matrix<double, 6, 1> s;
-        s << Eigen::Vector3d::Constant(1.0 / std::max(scale, 1e-6)), Eigen::Vector3d::Ones();
-        const Eigen::Matrix<double, 6, 6> An = s.asDiagonal() * A * s.asDiagonal();
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(An);
-        r.conditioning = es.eigenvalues()(0) / std::max(es.eigenvalues()(5), 1e-12);
-      }
-      const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
-      if (!x.allFinite())
-        break;
-      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-      const double angle = x.head<3>().norm();
-      if (angle > 0)
-        step.linear() = Eigen::AngleAxisd(angle, x.head<3>() / angle).toRotationMatrix();
-      step.translation() = centre - step.linear() * centre + x.tail<3>();
-      r.transform = step * r.transform;
-      // Coarse levels only have to hand over to the next: their steps scale with the voxel.
-      const double scale = c.voxels[level] / c.voxels.back();
-      if (angle < scale * c.min_rotation_step * DEG &&
-          x.tail<3>().norm() < scale * c.min_translation_step) {
-        r.converged = true;
-        break;
-      }
-      // Hard nearest-neighbour pairs can flip back and forth between two near-equal poses; a
-      // run of steps within ten times the limits is such a cycle, and as converged as it gets.
-      small_steps = angle < 10 * scale * c.min_rotation_step * DEG &&
-                            x.tail<3>().norm() < 10 * scale * c.min_translation_step
-                        ? small_steps + 1
-                        : 0;
-      if (small_steps >= 4) {
-        r.converged = true;
-        break;
-      }
-    }
-  }
+  for (int level = first_level; level <= last_level; ++level)
+    alignLevel(r, source_p, target_p, level, c);
   return r;
 }
 
