@@ -154,23 +154,23 @@ std::vector<int> assign(const std::vector<std::vector<double>>& cost, double for
 // More primary branches than any tree has (a model of noise): refused rather than scored.
 constexpr std::size_t MAX_DETECTIONS = 100000;
 
-TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
-                   const MatchBounds& bounds) {
-  constexpr double FORBIDDEN = 1e9;
-  TreeScore s;
-  s.pb = static_cast<int>(truth.primary_branches.size());
-  s.runtime_s = model.runtime_s;
-  if (model.primary_branches.size() > MAX_DETECTIONS) {
-    throw Error(ErrorCode::INVALID_ARGUMENT, "the model has " +
-                                                 std::to_string(model.primary_branches.size()) +
-                                                 " primary branches; no tree has more than " +
-                                                 std::to_string(MAX_DETECTIONS) + ": not scored");
-  }
+namespace {
+
+constexpr double FORBIDDEN = 1e9;  // the cost of a pair that cannot match
+// Samples along each trunk cylinder for the centreline error: its ends and 3 between.
+constexpr int CENTRE_SAMPLES = 4;
+
+/// The cost of each detection-truth pair (its axis error), FORBIDDEN where they cannot
+/// match; any_primary says which detections can match some primary branch.
+std::vector<std::vector<double>> matchCosts(const modeling::TreeModel& model,
+                                            const GroundTruth& truth, const MatchBounds& bounds,
+                                            std::vector<char>& any_primary) {
   const int detections = static_cast<int>(model.primary_branches.size());
-  std::vector<std::vector<double>> cost(detections, std::vector<double>(s.pb, FORBIDDEN));
-  std::vector<char> any_primary(detections, 0);
+  const int pb = static_cast<int>(truth.primary_branches.size());
+  std::vector<std::vector<double>> cost(detections, std::vector<double>(pb, FORBIDDEN));
+  any_primary.assign(detections, 0);
   for (int d = 0; d < detections; ++d) {
-    for (int t = 0; t < s.pb; ++t) {
+    for (int t = 0; t < pb; ++t) {
       double e = 0.0;
       if (canMatch(model.primary_branches[d].cylinder, truth.primary_branches[t], bounds, &e)) {
         cost[d][t] = e;
@@ -178,9 +178,15 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
       }
     }
   }
-  const auto assignment = assign(cost, FORBIDDEN);
-  double sq = 0.0;
-  for (int d = 0; d < detections; ++d) {
+  return cost;
+}
+
+/// The matched detections with their diameter errors; the unmatched ones are false positives,
+/// or ignored when they match a minor branch and no primary.
+void scoreDetections(const modeling::TreeModel& model, const GroundTruth& truth,
+                     const MatchBounds& bounds, const std::vector<int>& assignment,
+                     const std::vector<char>& any_primary, TreeScore& s, double& sq) {
+  for (int d = 0; d < static_cast<int>(assignment.size()); ++d) {
     if (assignment[d] >= 0) {
       PolylinePoint at;
       double e = 0.0;
@@ -207,6 +213,10 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
       s.false_positives.push_back(d);
     }
   }
+}
+
+/// The counts, rates, F1 and mean diameter errors from the matches.
+void summarise(TreeScore& s, int detections, double sq) {
   s.tp = static_cast<int>(s.matches.size());
   s.fn = s.pb - s.tp;
   std::vector<char> found(s.pb, 0);
@@ -226,8 +236,12 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
   s.fn_rate = s.pb > 0 ? static_cast<double>(s.fn) / s.pb : 0.0;
   const int denom = 2 * s.tp + s.fp + s.fn;
   s.f1 = denom > 0 ? 2.0 * s.tp / denom : 1.0;
+}
 
-  // Trunk.
+/// The trunk: diameter MAE weighted by cylinder length, the mean distance of the cylinders'
+/// axes from the true centreline, and the share of the trunk up to its highest primary branch
+/// that the cylinders cover.
+void scoreTrunk(const modeling::TreeModel& model, const GroundTruth& truth, TreeScore& s) {
   double weight = 0.0, weighted = 0.0, centre_sum = 0.0;
   int centre_n = 0;
   std::vector<std::pair<double, double>> spans;
@@ -235,8 +249,9 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
     const PolylinePoint q = closestPoint(truth.trunk, c.center);
     weighted += c.length * std::abs(c.diameter - q.diameter);
     weight += c.length;
-    for (int k = 0; k <= 4; ++k) {
-      const Eigen::Vector3d p = c.center + (k / 4.0 - 0.5) * c.length * c.axis;
+    for (int k = 0; k <= CENTRE_SAMPLES; ++k) {
+      const Eigen::Vector3d p =
+          c.center + (k / static_cast<double>(CENTRE_SAMPLES) - 0.5) * c.length * c.axis;
       centre_sum += closestPoint(truth.trunk, p).distance;
       ++centre_n;
     }
@@ -260,6 +275,28 @@ TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
     reach = std::max(reach, sp.second);
   }
   s.coverage = top > 0.0 ? std::min(1.0, covered / top) : 0.0;
+}
+
+}  // namespace
+
+TreeScore evaluate(const modeling::TreeModel& model, const GroundTruth& truth,
+                   const MatchBounds& bounds) {
+  TreeScore s;
+  s.pb = static_cast<int>(truth.primary_branches.size());
+  s.runtime_s = model.runtime_s;
+  if (model.primary_branches.size() > MAX_DETECTIONS) {
+    throw Error(ErrorCode::INVALID_ARGUMENT, "the model has " +
+                                                 std::to_string(model.primary_branches.size()) +
+                                                 " primary branches; no tree has more than " +
+                                                 std::to_string(MAX_DETECTIONS) + ": not scored");
+  }
+  std::vector<char> any_primary;
+  const auto cost = matchCosts(model, truth, bounds, any_primary);
+  const auto assignment = assign(cost, FORBIDDEN);
+  double sq = 0.0;
+  scoreDetections(model, truth, bounds, assignment, any_primary, s, sq);
+  summarise(s, static_cast<int>(model.primary_branches.size()), sq);
+  scoreTrunk(model, truth, s);
   return s;
 }
 

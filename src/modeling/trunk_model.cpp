@@ -629,6 +629,117 @@ void boundByTheSegmentBelow(std::vector<Cylinder>& cylinders) {
 
 }  // namespace
 
+namespace {
+
+// The slice circles of a trunk stay within these shares of the trunk clusters' radius (a
+// circle through branch points can be any size).
+constexpr double SLICE_MIN_RADIUS_SHARE = 0.3;
+constexpr double SLICE_MAX_RADIUS_SHARE = 2.5;
+// Rounds of centreline refinement on the initial axis, and the least radius they assume.
+constexpr int CENTERLINE_ROUNDS = 2;
+constexpr double CENTERLINE_MIN_RADIUS = 0.02;     // m
+constexpr std::uint64_t SEGMENT_SEED_BASE = 1000;  // + the segment's index
+
+/// Each region point's position along the centreline and distance from it, on all cores.
+void projectRegion(const Points& pts, const std::vector<int>& region, const Centerline& line,
+                   std::vector<double>& s, std::vector<double>& dist) {
+  parallelFor(static_cast<int>(region.size()),
+              [&](int k) { s[k] = line.project(pts[region[k]], &dist[k]); });
+}
+
+SliceBounds sliceBounds(double initial_radius) {
+  SliceBounds bounds;
+  if (initial_radius > 0.0) {
+    bounds.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * initial_radius);
+    bounds.max_radius = std::min(MAX_TRUNK_RADIUS, SLICE_MAX_RADIUS_SHARE * initial_radius);
+    bounds.max_distance = trunkReach(initial_radius);
+  }
+  return bounds;
+}
+
+/// The region's range noise: the configured one, or estimated from the slices.
+double trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
+                  const std::vector<Slice>& slices, const ModelerConfig& config) {
+  if (config.noise_sigma >= 0.0)
+    return config.noise_sigma;
+  Points region_pts;
+  for (const int i : region)
+    region_pts.push_back(pts[i]);
+  const double estimate = estimateNoiseSigma(region_pts, line, slices, config.slice_height);
+  return estimate > 0.0 ? estimate : 0.0;
+}
+
+/// The segment boundaries along the centreline: disturbance partitions, short ones joined,
+/// split at curvature, at bends (trunk_max_bend) and where too long.
+std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
+                              const std::vector<double>& s, const std::vector<double>& dist,
+                              const SliceBounds& bounds, const Centerline& line,
+                              const std::vector<Slice>& slices, double cylinder_threshold,
+                              double scatter, const ModelerConfig& config) {
+  const double h = config.slice_height;
+  double top = 0.0;
+  for (const auto& sl : slices) {
+    if (sl.points >= MIN_SLICE_POINTS)
+      top = std::max(top, sl.s0 + h);
+  }
+  const auto joined =
+      joinShortSegments(disturbancePartitions(slices, h, config.disturbance_zero_run, top),
+                        config.min_segment_length);
+  std::vector<double> cuts = splitAtCurvature(pts, region, s, dist, bounds, line, slices, joined,
+                                              cylinder_threshold, scatter, config);
+  if (config.trunk_max_bend > 0.0) {
+    std::vector<double> straight{cuts.front()};
+    for (std::size_t i = 1; i < cuts.size(); ++i) {
+      splitAtBends(line, straight.back(), cuts[i], h, config.trunk_max_bend,
+                   config.min_segment_length, straight);
+      straight.push_back(cuts[i]);
+    }
+    cuts = std::move(straight);
+  }
+  if (config.trunk_max_segment_length > 0.0)
+    cuts = splitLongSegments(cuts, config.trunk_max_segment_length);
+  return cuts;
+}
+
+/// One cylinder per segment; with ours_follow_diameter a segment no RANSAC cylinder fits (a
+/// whorl of branches, a bend) takes the centreline's chord and the slices' median radius,
+/// rather than leaving a gap in the trunk that would orphan the branches on it.
+void fitCylinders(const Points& pts, const std::vector<int>& region, const std::vector<double>& s,
+                  const std::vector<double>& dist, const SliceBounds& bounds,
+                  double cylinder_threshold, double scatter, const ModelerConfig& config,
+                  TrunkModel& trunk) {
+  const std::vector<double>& cuts = trunk.partitions;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double a = cuts[i], b = cuts[i + 1];
+    if (auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, trunk.centerline, trunk.slices,
+                              cylinder_threshold, scatter, config, SEGMENT_SEED_BASE + i)) {
+      trunk.cylinders.push_back(*cyl);
+      trunk.cylinder_ranges.emplace_back(a, b);
+    } else if (config.ours_follow_diameter) {
+      if (auto chord =
+              segmentFromSlices(trunk.slices, trunk.centerline, a, b, config.slice_height)) {
+        trunk.cylinders.push_back(*chord);
+        trunk.cylinder_ranges.emplace_back(a, b);
+      }
+    }
+  }
+}
+
+/// The cylinders' radii from a taper profile fitted to the slices, when one fits.
+void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
+  const auto profile =
+      TaperProfile::fit(trunk.slices, config.slice_height, TAPER_BELOW,
+                        trunk.noise_sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE);
+  if (!profile)
+    return;
+  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+    const auto& [a, b] = trunk.cylinder_ranges[i];
+    trunk.cylinders[i].radius = std::max(MIN_TRUNK_RADIUS, profile->mean(a, b));
+  }
+}
+
+}  // namespace
+
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
                       const ModelerConfig& config) {
@@ -639,37 +750,18 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   const double h = config.slice_height;
   Centerline line(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   std::vector<double> s(region.size()), dist(region.size());
-  auto projectAll = [&] {
-    parallelFor(static_cast<int>(region.size()),
-                [&](int k) { s[k] = line.project(pts[region[k]], &dist[k]); });
-  };
-  projectAll();
-  // Slice circles stay near the radius of the trunk clusters (a circle through branch points
-  // can be any size) and use the points near the axis.
-  SliceBounds bounds;
-  if (initial_radius > 0.0) {
-    bounds.min_radius = std::max(MIN_TRUNK_RADIUS, 0.3 * initial_radius);
-    bounds.max_radius = std::min(MAX_TRUNK_RADIUS, 2.5 * initial_radius);
-    bounds.max_distance = trunkReach(initial_radius);
-  }
-  // Pass 1: slices on the initial axis, to refine the centreline and estimate the noise.
+  projectRegion(pts, region, line, s, dist);
+  const SliceBounds bounds = sliceBounds(initial_radius);
+  // Slices on the initial axis refine the centreline; then the noise is estimated.
   auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds,
                               nullptr, 0.0, std::nullopt, config);
-  for (int round = 0; round < 2; ++round) {
-    line = refineCenterline(slices, line, std::max(initial_radius, 0.02), h);
-    projectAll();
+  for (int round = 0; round < CENTERLINE_ROUNDS; ++round) {
+    line = refineCenterline(slices, line, std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
+    projectRegion(pts, region, line, s, dist);
     slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr,
                            0.0, std::nullopt, config);
   }
-
-  Points region_pts;
-  for (const int i : region)
-    region_pts.push_back(pts[i]);
-  double sigma = config.noise_sigma;
-  if (sigma < 0.0) {
-    const double estimate = estimateNoiseSigma(region_pts, line, slices, h);
-    sigma = estimate > 0.0 ? estimate : 0.0;
-  }
+  const double sigma = trunkNoise(pts, region, line, slices, config);
   trunk.noise_sigma = sigma;
   const double scatter =
       config.ours_correct_noise_bias ? std::hypot(sigma, config.beam_spread) : 0.0;
@@ -688,55 +780,13 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   trunk.slices = slices;
   trunk.centerline = line;
-  double top = 0.0;
-  for (const auto& sl : slices) {
-    if (sl.points >= MIN_SLICE_POINTS)
-      top = std::max(top, sl.s0 + h);
-  }
-  const auto cuts = disturbancePartitions(slices, h, config.disturbance_zero_run, top);
-  trunk.partitions = joinShortSegments(cuts, config.min_segment_length);
-  std::vector<double> final_cuts =
-      splitAtCurvature(pts, region, s, dist, bounds, line, slices, trunk.partitions,
-                       cylinder_threshold, scatter, config);
-  if (config.trunk_max_bend > 0.0) {
-    std::vector<double> straight{final_cuts.front()};
-    for (std::size_t i = 1; i < final_cuts.size(); ++i) {
-      splitAtBends(line, straight.back(), final_cuts[i], h, config.trunk_max_bend,
-                   config.min_segment_length, straight);
-      straight.push_back(final_cuts[i]);
-    }
-    final_cuts = std::move(straight);
-  }
-  if (config.trunk_max_segment_length > 0.0)
-    final_cuts = splitLongSegments(final_cuts, config.trunk_max_segment_length);
-  trunk.partitions = final_cuts;
-  for (std::size_t i = 0; i + 1 < final_cuts.size(); ++i) {
-    const double a = final_cuts[i], b = final_cuts[i + 1];
-    if (auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices, cylinder_threshold,
-                              scatter, config, 1000 + i)) {
-      trunk.cylinders.push_back(*cyl);
-      trunk.cylinder_ranges.emplace_back(a, b);
-    } else if (config.ours_follow_diameter) {
-      // The slices measured this stretch even where one RANSAC cylinder does not fit it (a
-      // whorl of branches, a bend): the centreline's chord and the slices' median radius,
-      // rather than a gap in the trunk that would orphan the branches on it.
-      if (auto chord = segmentFromSlices(slices, line, a, b, config.slice_height)) {
-        trunk.cylinders.push_back(*chord);
-        trunk.cylinder_ranges.emplace_back(a, b);
-      }
-    }
-  }
+  trunk.partitions =
+      trunkCuts(pts, region, s, dist, bounds, line, slices, cylinder_threshold, scatter, config);
+  fitCylinders(pts, region, s, dist, bounds, cylinder_threshold, scatter, config, trunk);
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
-  if (config.ours_correct_noise_bias && config.trunk_taper_profile) {
-    if (const auto profile = TaperProfile::fit(
-            slices, h, TAPER_BELOW, sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE)) {
-      for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
-        const auto& [a, b] = trunk.cylinder_ranges[i];
-        trunk.cylinders[i].radius = std::max(MIN_TRUNK_RADIUS, profile->mean(a, b));
-      }
-    }
-  }
+  if (config.ours_correct_noise_bias && config.trunk_taper_profile)
+    applyTaperProfile(trunk, config);
   if (config.ours_constrain_ransac)
     boundByTheSegmentBelow(trunk.cylinders);
   return trunk;
