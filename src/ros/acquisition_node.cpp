@@ -213,22 +213,8 @@ void AcquisitionNode::run() {
   const auto plan = acquisition::makeViewPlan(plan_);
   std::filesystem::create_directories(output_dir_);
   const std::string bag_path = output_dir_ + "/" + tree_name_ + ".bag";
-  try {
-    std::lock_guard<std::mutex> lock(bag_mutex_);
-    bag_.open(bag_path, rosbag::bagmode::Write);
-    recording_ = true;
-  } catch (const rosbag::BagException& e) {
-    acquisition::SequencerProgress none;
-    none.total = static_cast<int>(plan.size());
-    publishProgress(Progress::FAILED, none,
-                    std::string("cannot record to ") + bag_path + ": " + e.what());
-    ROS_ERROR("cannot record to %s: %s", bag_path.c_str(), e.what());
-    std::lock_guard<std::mutex> lock(mutex_);
-    last_problem_ = std::string("cannot record to ") + bag_path + ": " + e.what();
-    state_ = "idle";
-    running_ = false;
+  if (!openBag(bag_path, static_cast<int>(plan.size())))
     return;
-  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     state_ = "running";
@@ -237,39 +223,75 @@ void AcquisitionNode::run() {
     last_progress_ = acquisition::SequencerProgress{};
     last_problem_.clear();
   }
+  std::vector<acquisition::ViewOutcome> outcomes;
+  try {
+    outcomes = acquisition::runPlan(plan, sequencerActions(), max_retries_);
+  } catch (const Error& e) {
+    ROS_ERROR("acquisition stopped: %s", e.what());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = std::string("stopped: ") + e.what();
+  }
+  finishRun(outcomes, static_cast<int>(plan.size()), bag_path);
+}
+
+bool AcquisitionNode::openBag(const std::string& bag_path, int planned) {
+  try {
+    std::lock_guard<std::mutex> lock(bag_mutex_);
+    bag_.open(bag_path, rosbag::bagmode::Write);
+    recording_ = true;
+    return true;
+  } catch (const rosbag::BagException& e) {
+    acquisition::SequencerProgress none;
+    none.total = planned;
+    publishProgress(Progress::FAILED, none,
+                    std::string("cannot record to ") + bag_path + ": " + e.what());
+    ROS_ERROR("cannot record to %s: %s", bag_path.c_str(), e.what());
+    std::lock_guard<std::mutex> lock(mutex_);
+    last_problem_ = std::string("cannot record to ") + bag_path + ": " + e.what();
+    state_ = "idle";
+    running_ = false;
+    return false;
+  }
+}
+
+void AcquisitionNode::moveSlide(double slide) {
+  dormant_tree_modeling::MoveAxis m;
+  m.request.axis = slide_axis_;
+  m.request.target = slide_centre_ + slide;
+  m.request.velocity = slide_velocity_;
+  m.request.wait = true;
+  // At start-up the stage may still be connecting or homing: wait for it a while.
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(service_wait_s_);
+  while (true) {
+    if (!ros::service::waitForService(move_service_, ros::Duration(service_wait_s_)) ||
+        !ros::service::call(move_service_, m))
+      throw Error(ErrorCode::IO_FAILURE,
+                  "the stage service " + move_service_ + " is not available");
+    if (m.response.success)
+      return;
+    if (m.response.status != dormant_tree_modeling::MoveAxis::Response::NOT_READY ||
+        ros::WallTime::now() > give_up || cancel_)
+      throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
+    ros::WallDuration(0.5).sleep();
+  }
+}
+
+std::string AcquisitionNode::acquireView() {
+  std_srvs::Trigger t;
+  if (!ros::service::waitForService(acquire_service_, ros::Duration(service_wait_s_)) ||
+      !ros::service::call(acquire_service_, t))
+    throw Error(ErrorCode::IO_FAILURE,
+                "the assembler service " + acquire_service_ + " is not available");
+  if (!t.response.success)
+    throw Error(ErrorCode::IO_FAILURE, t.response.message);
+  return t.response.message;
+}
+
+acquisition::SequencerActions AcquisitionNode::sequencerActions() {
   acquisition::SequencerActions a;
   a.move_platform = [this](const acquisition::PlannedView& v) { return askForPlatform(v); };
-  a.move_slide = [this](double slide) {
-    dormant_tree_modeling::MoveAxis m;
-    m.request.axis = slide_axis_;
-    m.request.target = slide_centre_ + slide;
-    m.request.velocity = slide_velocity_;
-    m.request.wait = true;
-    // At start-up the stage may still be connecting or homing: wait for it a while.
-    const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(service_wait_s_);
-    while (true) {
-      if (!ros::service::waitForService(move_service_, ros::Duration(service_wait_s_)) ||
-          !ros::service::call(move_service_, m))
-        throw Error(ErrorCode::IO_FAILURE,
-                    "the stage service " + move_service_ + " is not available");
-      if (m.response.success)
-        return;
-      if (m.response.status != dormant_tree_modeling::MoveAxis::Response::NOT_READY ||
-          ros::WallTime::now() > give_up || cancel_)
-        throw Error(ErrorCode::IO_FAILURE, "slide move failed: " + m.response.message);
-      ros::WallDuration(0.5).sleep();
-    }
-  };
-  a.acquire_view = [this](const acquisition::PlannedView&) {
-    std_srvs::Trigger t;
-    if (!ros::service::waitForService(acquire_service_, ros::Duration(service_wait_s_)) ||
-        !ros::service::call(acquire_service_, t))
-      throw Error(ErrorCode::IO_FAILURE,
-                  "the assembler service " + acquire_service_ + " is not available");
-    if (!t.response.success)
-      throw Error(ErrorCode::IO_FAILURE, t.response.message);
-    return t.response.message;
-  };
+  a.move_slide = [this](double slide) { moveSlide(slide); };
+  a.acquire_view = [this](const acquisition::PlannedView&) { return acquireView(); };
   a.progress = [this](const acquisition::SequencerProgress& p) {
     const std::string line = acquisition::progressLine(p);
     publishProgress(Progress::RUNNING, p, line);
@@ -280,21 +302,18 @@ void AcquisitionNode::run() {
     failed_ = p.failed;
   };
   a.cancelled = [this] { return cancel_.load() || !ros::ok(); };
-  std::vector<acquisition::ViewOutcome> outcomes;
-  try {
-    outcomes = acquisition::runPlan(plan, a, max_retries_);
-  } catch (const Error& e) {
-    ROS_ERROR("acquisition stopped: %s", e.what());
-    std::lock_guard<std::mutex> lock(mutex_);
-    last_problem_ = std::string("stopped: ") + e.what();
-  }
+  return a;
+}
+
+void AcquisitionNode::finishRun(const std::vector<acquisition::ViewOutcome>& outcomes, int planned,
+                                const std::string& bag_path) {
   // Messages of the last view may still be in transit (the view cloud is published just
   // before acquire_view returns): let them arrive before the bag closes.
   ros::WallDuration(drain_s_).sleep();
-  const std::string report = acquisition::outcomesMarkdown(outcomes, static_cast<int>(plan.size()));
+  const std::string report = acquisition::outcomesMarkdown(outcomes, planned);
   const std::string summary = report.substr(0, report.find('\n'));
   acquisition::SequencerProgress end = last_progress_;
-  end.total = static_cast<int>(plan.size());
+  end.total = planned;
   end.done = 0;
   end.failed = 0;
   for (const auto& o : outcomes)

@@ -48,6 +48,17 @@ class AcquisitionNode {
   bool platformInPlace(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void run();
   bool askForPlatform(const acquisition::PlannedView& view);
+  /// Opens the tree's bag; false (said on ~progress and in the diagnostics) when it cannot.
+  bool openBag(const std::string& bag_path, int planned);
+  /// The sequencer's steps through the stage's and the assembler's services.
+  acquisition::SequencerActions sequencerActions();
+  /// Moves the slide; waits up to ~service_wait for a stage that is still setting up.
+  void moveSlide(double slide);
+  /// Sweeps and assembles one view; returns the assembler's summary.
+  std::string acquireView();
+  /// Closes the bag with the plan's end in it, writes the report, then announces the end.
+  void finishRun(const std::vector<acquisition::ViewOutcome>& outcomes, int planned,
+                 const std::string& bag_path);
   void record(const std::string& topic, const topic_tools::ShapeShifter::ConstPtr& msg);
   void publish(ros::Publisher& pub, const std::string& text);
   static dormant_tree_modeling::AcquisitionProgress progressMessage(
