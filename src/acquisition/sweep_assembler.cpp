@@ -39,6 +39,8 @@ std::optional<double> StagePositionHistory::at(double stamp) const {
   return before->theta + w * (after->theta - before->theta);
 }
 
+// One pass over the sweep's lines that fills the image row by row (angle lookup, binning and
+// the counts the caller reports are shared state of that pass).
 RangeImage assembleRangeImage(const std::vector<SweepLine>& lines,
                               const StagePositionHistory& history, double theta_min,
                               double theta_max, std::size_t* dropped, double theta_step,

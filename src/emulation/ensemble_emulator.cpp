@@ -196,6 +196,8 @@ EnsembleResponse EmulatedEnsemble::motion(Axis& a, double now_s) {
   return {a.fault_at >= 0 ? "#" : "%", std::max(now_s, end)};
 }
 
+// Long by design: one branch per controller command the client uses (docs/protocols.md), each
+// a few lines, in one place as in the controller's command reference.
 EnsembleResponse EmulatedEnsemble::handle(const std::string& line, double now_s) {
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto& [name, axis] : axes_)

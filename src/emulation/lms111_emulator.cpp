@@ -217,6 +217,8 @@ std::string EmulatedLms111::answer(const std::string& payload, const std::string
   }
 }
 
+// Long by design: one case per command of the device (docs/protocols.md), each a few lines of
+// argument checks and state, in one place as in the vendor's telegram listing.
 std::string EmulatedLms111::dispatch(const std::string& type, const std::string& name,
                                      FieldReader& r, LmsSession& session, double now_s) {
   auto requireLevel = [&]() {

@@ -89,6 +89,9 @@ bool isScanTelegram(const std::string& payload) {
          (payload.size() == end || payload[end] == ' ');
 }
 
+// One walk over the telegram's fields in their order on the wire (docs/protocols.md), with the
+// field and offset in every error; split, the order would be harder to check against SICK's
+// listing.
 ScanTelegram parseScanTelegram(const std::string& payload, Protocol protocol) {
   const auto reader = makeReader(protocol, payload);
   FieldReader& r = *reader;

@@ -254,6 +254,7 @@ bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& confi
          std::abs(cluster.fit->axis.z()) >= std::cos(config.trunk_max_tilt * DEG);
 }
 
+// Algorithm 2 as the paper writes it: one walk up the cluster graph from the trunk base.
 TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
                         const std::vector<std::vector<int>>& adjacency,
                         const ModelerConfig& config) {

@@ -376,6 +376,8 @@ double TrunkModel::diameterAt(double s) const {
   return 2.0 * cylinders.back().radius;
 }
 
+// One climb up the trunk, circle by circle; the state carried between steps (last circle,
+// step, misses) is what keeps it one loop.
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
                         const ModelerConfig& config, int max_misses, bool trust_radius) {

@@ -5,6 +5,8 @@
 namespace dormant_tree_modeling {
 namespace registration {
 
+// One key per line, as in config/registration.yaml; issue #26 step 4 replaces it with a field
+// table shared with the modeler's configuration.
 RegistrationConfig loadRegistrationConfig(const std::string& path) {
   RegistrationConfig c;
   forEachYamlEntry(

@@ -14,6 +14,8 @@
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
+// Long by design: the options (scene, pose, noise, faults, session) in the order --help lists
+// them, then the server.
 int main(int argc, char** argv) {
   emulation::LmsServerOptions server;
   emulation::LmsEmulatorConfig device;

@@ -15,6 +15,7 @@
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
+// Long by design: the options in the order --help lists them, then register and write.
 int main(int argc, char** argv) {
   std::string dir, out, params, calibration;
   po::options_description desc(

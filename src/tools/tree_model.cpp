@@ -37,6 +37,8 @@ int exitCode(ErrorCode code) {
 
 }  // namespace
 
+// Long by design: the options in the order --help lists them, then model, write and the
+// verbose report, each a few lines.
 int main(int argc, char** argv) {
   std::string input, output, params, csv, picture, calibration;
   po::options_description desc(
