@@ -130,7 +130,7 @@ class BranchSearch {
   void pushParts(const std::vector<int>& rest);
   bool budgetLeft() const;
 
-  const BranchContext& context_;
+  const BranchContext context_;  // a copy: callers pass a temporary (it holds references only)
   const BranchCandidates& candidates_;
   std::vector<RejectedBranch>* rejected_;
   std::vector<Candidate> work_;
