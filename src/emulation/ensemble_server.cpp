@@ -8,6 +8,7 @@
 
 #include "dormant_tree_modeling/aerotech/ascii_protocol.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "listen.h"
 
 namespace dormant_tree_modeling {
 namespace emulation {
@@ -149,22 +150,8 @@ EnsembleServer::EnsembleServer(std::shared_ptr<EmulatedEnsemble> controller,
     : impl_(std::make_unique<Impl>(std::move(controller))) {
   if (!impl_->controller)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the Ensemble server needs a controller");
-  boost::system::error_code ec;
-  const tcp::endpoint endpoint(asio::ip::make_address(address, ec),
-                               static_cast<unsigned short>(port));
   auto& a = impl_->acceptor;
-  if (!ec)
-    a.open(endpoint.protocol(), ec);
-  if (!ec)
-    a.set_option(tcp::acceptor::reuse_address(true), ec);
-  if (!ec)
-    a.bind(endpoint, ec);
-  if (!ec)
-    a.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) {
-    throw Error(ErrorCode::IO_FAILURE, "Ensemble emulator cannot listen on " + address + ":" +
-                                           std::to_string(port) + ": " + ec.message());
-  }
+  listenOn(a, address, port, "Ensemble emulator");
   impl_->bound = a.local_endpoint().port();
   impl_->accept();
   thread_ = std::thread([this] { impl_->io.run(); });

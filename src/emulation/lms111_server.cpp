@@ -6,6 +6,7 @@
 #include <list>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "listen.h"
 
 namespace dormant_tree_modeling {
 namespace emulation {
@@ -128,22 +129,7 @@ struct LmsServer::Impl {
       const int bind_port = bound[p] > 0 ? bound[p] : port;
       auto& acceptor = acceptors[p];
       acceptor = std::make_unique<tcp::acceptor>(io);
-      boost::system::error_code ec;
-      const tcp::endpoint endpoint(asio::ip::make_address(options.address, ec),
-                                   static_cast<unsigned short>(bind_port));
-      if (!ec)
-        acceptor->open(endpoint.protocol(), ec);
-      if (!ec)
-        acceptor->set_option(tcp::acceptor::reuse_address(true), ec);
-      if (!ec)
-        acceptor->bind(endpoint, ec);
-      if (!ec)
-        acceptor->listen(asio::socket_base::max_listen_connections, ec);
-      if (ec) {
-        throw Error(ErrorCode::IO_FAILURE, "LMS111 emulator cannot listen on " + options.address +
-                                               ":" + std::to_string(bind_port) + ": " +
-                                               ec.message());
-      }
+      listenOn(*acceptor, options.address, bind_port, "LMS111 emulator");
       bound[p] = acceptor->local_endpoint().port();
       accept(p);
     }
