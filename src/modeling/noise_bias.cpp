@@ -37,13 +37,10 @@ constexpr int ROD_RETURNS_PER_VIEW = 150;
 constexpr int REPEATS = 8;
 constexpr double ROD_LENGTH_M = 0.25;  // about branch_fit_length
 const double ROD_ELEVATIONS_RAD[] = {0.0, 20.0 * M_PI / 180.0, 40.0 * M_PI / 180.0};
-// The trunk step bounds a slice radius by the trunk's (0.3x..2.5x), the branch step a branch's
-// by the trunk radius where it leaves: primaries are 0.3..0.6 of it.
-constexpr double SLICE_MIN_FACTOR = 0.3;
-constexpr double SLICE_MAX_FACTOR = 2.5;
+// The trunk step bounds a slice radius by the trunk's (SLICE_*_RADIUS_SHARE), the branch step a
+// branch's by the trunk radius where it leaves: primaries are 0.3..0.6 of it.
 constexpr double TRUNK_TO_BRANCH = 2.5;
 constexpr double MIN_BRANCH_BOUND_M = 0.025;
-constexpr double MIN_TRUNK_RADIUS_M = 0.003;
 // The noise estimator reads thick trunk slices: a 5 cm radius stands for them.
 constexpr double ESTIMATOR_RADIUS_M = 0.05;
 constexpr double MIN_AXIS_STEP_M = 1e-5;
@@ -86,8 +83,8 @@ CircleRansacOptions sliceOptions(const ModelerConfig& config, double r, double s
   o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, noiseBand(sigma))
                                               : config.circle_threshold;
   o.iterations = config.ransac_iterations;
-  o.min_radius = std::max(MIN_TRUNK_RADIUS_M, SLICE_MIN_FACTOR * r);
-  o.max_radius = SLICE_MAX_FACTOR * r;
+  o.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * r);
+  o.max_radius = SLICE_MAX_RADIUS_SHARE * r;
   o.seed = seed;
   return o;
 }

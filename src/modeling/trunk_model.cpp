@@ -22,7 +22,6 @@ namespace {
 constexpr double DEG = M_PI / 180.0;
 constexpr double ZERO_SLOPE = 0.05;  // |d eta_share| below this is a flat eta
 constexpr int MIN_SLICE_POINTS = 12;
-constexpr double MIN_TRUNK_RADIUS = 0.003;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
 constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
 constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
@@ -633,10 +632,6 @@ void boundByTheSegmentBelow(std::vector<Cylinder>& cylinders) {
 
 namespace {
 
-// The slice circles of a trunk stay within these shares of the trunk clusters' radius (a
-// circle through branch points can be any size).
-constexpr double SLICE_MIN_RADIUS_SHARE = 0.3;
-constexpr double SLICE_MAX_RADIUS_SHARE = 2.5;
 // Rounds of centreline refinement on the initial axis, and the least radius they assume.
 constexpr int CENTERLINE_ROUNDS = 2;
 constexpr double CENTERLINE_MIN_RADIUS = 0.02;     // m

@@ -96,24 +96,24 @@ struct Pairs {
 
 // Each source point with its nearest target point: point-to-plane, or point-to-ray when the
 // two were seen from opposite sides.
-void matchPoints(const LevelPair& L, const Eigen::Isometry3d& t, const IcpConfig& c,
+void matchPoints(const LevelPair& clouds, const Eigen::Isometry3d& t, const IcpConfig& c,
                  std::vector<Match>& matches, std::vector<char>& valid) {
   const Eigen::Matrix3d rot = t.linear();
-  parallelFor(static_cast<int>(L.source.size()), [&](int i) {
+  parallelFor(static_cast<int>(clouds.source.size()), [&](int i) {
     valid[i] = 0;
-    const Eigen::Vector3d p = t * L.source.points[i];
-    const int j = L.index.nearestOne(p);
+    const Eigen::Vector3d p = t * clouds.source.points[i];
+    const int j = clouds.index.nearestOne(p);
     if (j < 0)
       return;
-    const Eigen::Vector3d& n = L.target.normals[j];
+    const Eigen::Vector3d& n = clouds.target.normals[j];
     if (n.isZero())
       return;
-    const Eigen::Vector3d d = p - L.target.points[j];
-    if (d.squaredNorm() > L.limit * L.limit)
+    const Eigen::Vector3d d = p - clouds.target.points[j];
+    if (d.squaredNorm() > clouds.limit * clouds.limit)
       return;
-    const Eigen::Vector3d& vt = L.target.view_dirs[j];
-    const bool across = !vt.isZero() && !L.source.view_dirs[i].isZero() &&
-                        (rot * L.source.view_dirs[i]).dot(vt) < c.across_cos;
+    const Eigen::Vector3d& vt = clouds.target.view_dirs[j];
+    const bool across = !vt.isZero() && !clouds.source.view_dirs[i].isZero() &&
+                        (rot * clouds.source.view_dirs[i]).dot(vt) < c.across_cos;
     const double ray_gap = across ? (d - d.dot(vt) * vt).norm() : 0.0;
     matches[i] = {i, j, across ? ray_gap : d.dot(n), across ? ray_gap : d.norm(), across};
     valid[i] = 1;
@@ -122,21 +122,22 @@ void matchPoints(const LevelPair& L, const Eigen::Isometry3d& t, const IcpConfig
 
 // The pairs an iteration uses: the point pairs (without the opposite-side ones when axis pairs
 // say where the branches are) and the axis pairs, each kept to its `trim` share of the closest.
-Pairs pairUp(const LevelPair& L, const Eigen::Isometry3d& t, const IcpConfig& c,
+Pairs pairUp(const LevelPair& clouds, const Eigen::Isometry3d& t, const IcpConfig& c,
              std::vector<Match>& matches, std::vector<char>& valid) {
-  matchPoints(L, t, c, matches, valid);
+  matchPoints(clouds, t, c, matches, valid);
   Pairs pairs;
   std::size_t close = 0;
-  for (std::size_t i = 0; i < L.source.size(); ++i) {
+  for (std::size_t i = 0; i < clouds.source.size(); ++i) {
     if (!valid[i])
       continue;
     close += matches[i].gap <= c.overlap_distance;
-    if (!(L.axis_index && matches[i].across))
+    if (!(clouds.axis_index && matches[i].across))
       pairs.used.push_back(matches[i]);
   }
-  pairs.overlap = static_cast<double>(close) / L.source.size();
-  if (L.axis_index) {
-    pairs.axes = matchAxes(L.source_axes, L.target_axes, *L.axis_index, t, L.limit, c);
+  pairs.overlap = static_cast<double>(close) / clouds.source.size();
+  if (clouds.axis_index) {
+    pairs.axes =
+        matchAxes(clouds.source_axes, clouds.target_axes, *clouds.axis_index, t, clouds.limit, c);
     const std::size_t axis_keep = static_cast<std::size_t>(c.trim * pairs.axes.size());
     if (axis_keep < pairs.axes.size()) {
       std::nth_element(pairs.axes.begin(), pairs.axes.begin() + axis_keep, pairs.axes.end(),
@@ -189,44 +190,45 @@ struct Step {
   double rmse = 0, conditioning = 0;
 };
 
-Eigen::Vector3d pairCentroid(const LevelPair& L, const Pairs& pairs, const Eigen::Isometry3d& t) {
+Eigen::Vector3d pairCentroid(const LevelPair& clouds, const Pairs& pairs,
+                             const Eigen::Isometry3d& t) {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const auto& m : pairs.used)
-    centre += t * L.source.points[m.source];
+    centre += t * clouds.source.points[m.source];
   for (const auto& m : pairs.axes)
-    centre += t * L.source_axes.points[m.source];
+    centre += t * clouds.source_axes.points[m.source];
   return centre / static_cast<double>(pairs.used.size() + pairs.axes.size());
 }
 
-Step solveStep(const LevelPair& L, const Pairs& pairs, const Eigen::Isometry3d& t,
+Step solveStep(const LevelPair& clouds, const Pairs& pairs, const Eigen::Isometry3d& t,
                const IcpConfig& c) {
   const double n_pairs = static_cast<double>(pairs.used.size() + pairs.axes.size());
-  const Eigen::Vector3d centre = pairCentroid(L, pairs, t);
+  const Eigen::Vector3d centre = pairCentroid(clouds, pairs, t);
   const auto huberWeight = [&](double e) {
     return std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
   };
   NormalEquations eq;
   double sq = 0, radius_sq = 0;
   for (const auto& m : pairs.used) {
-    const Eigen::Vector3d q = t * L.source.points[m.source];
+    const Eigen::Vector3d q = t * clouds.source.points[m.source];
     const Eigen::Vector3d p = q - centre;
     radius_sq += p.squaredNorm();
     const double w = huberWeight(m.residual);
     sq += m.residual * m.residual;
     if (!m.across) {
-      eq.addRow(p, L.target.normals[m.target], m.residual, w);
+      eq.addRow(p, clouds.target.normals[m.target], m.residual, w);
       continue;
     }
     // Seen from opposite sides, the two points lie on opposite halves of a branch: only the
     // offset across the target's ray says how far apart the branch axes are.
-    eq.addAcross(p, L.target.view_dirs[m.target], q - L.target.points[m.target], w);
+    eq.addAcross(p, clouds.target.view_dirs[m.target], q - clouds.target.points[m.target], w);
   }
   for (const auto& m : pairs.axes) {
-    const Eigen::Vector3d q = t * L.source_axes.points[m.source];
+    const Eigen::Vector3d q = t * clouds.source_axes.points[m.source];
     radius_sq += (q - centre).squaredNorm();
     sq += m.gap * m.gap;
-    eq.addAcross(q - centre, L.target_axes.directions[m.target], q - L.target_axes.points[m.target],
-                 huberWeight(m.gap));
+    eq.addAcross(q - centre, clouds.target_axes.directions[m.target],
+                 q - clouds.target_axes.points[m.target], huberWeight(m.gap));
   }
   Step step;
   step.rmse = std::sqrt(sq / n_pairs);
@@ -262,13 +264,13 @@ void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, 
   std::optional<modeling::PointIndex> axis_index;
   if (use_axes)
     axis_index.emplace(target_p.axes.points);
-  const LevelPair L{source,
-                    target,
-                    index,
-                    source_p.axes,
-                    target_p.axes,
-                    axis_index ? &*axis_index : nullptr,
-                    c.distance_factor * c.voxels[level]};
+  const LevelPair clouds{source,
+                         target,
+                         index,
+                         source_p.axes,
+                         target_p.axes,
+                         axis_index ? &*axis_index : nullptr,
+                         c.distance_factor * c.voxels[level]};
   std::vector<Match> matches(source.size());
   std::vector<char> valid(source.size());
   r.converged = false;
@@ -277,12 +279,12 @@ void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, 
   const double scale = c.voxels[level] / c.voxels.back();
   for (int it = 0; it < c.max_iterations; ++it) {
     ++r.iterations;
-    Pairs pairs = pairUp(L, r.transform, c, matches, valid);
+    Pairs pairs = pairUp(clouds, r.transform, c, matches, valid);
     r.overlap = pairs.overlap;
     if (pairs.used.size() + pairs.axes.size() < MIN_PAIRS)
       throw Error(ErrorCode::EMPTY_INPUT, "ICP: the clouds do not overlap at the guess");
     trimPairs(pairs.used, c.trim);
-    const Step step = solveStep(L, pairs, r.transform, c);
+    const Step step = solveStep(clouds, pairs, r.transform, c);
     r.rmse = step.rmse;
     r.conditioning = step.conditioning;
     if (!step.x.allFinite())

@@ -11,6 +11,13 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
+/// @brief A trunk's least radius, m.
+constexpr double MIN_TRUNK_RADIUS = 0.003;
+/// @brief Slice circles are searched between these shares of the trunk clusters' radius (a
+/// circle through branch points can be any size); the noise-bias tables run the same search.
+constexpr double SLICE_MIN_RADIUS_SHARE = 0.3;
+constexpr double SLICE_MAX_RADIUS_SHARE = 2.5;
+
 /// @brief A polyline with arc-length projection, used as the trunk's centreline.
 class Centerline {
  public:
