@@ -12,7 +12,7 @@ CMAKE_ARGS := -DPYTHON_EXECUTABLE=$(PYTHON) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DC
 	-DCATKIN_DEVEL_PREFIX=$(BUILD)/devel
 SOURCES = $(shell cd $(ROOT) && git ls-files -co --exclude-standard -- '*.cpp' '*.h')
 
-.PHONY: all setup build test bench fuzz demo format format-check lint clean help
+.PHONY: all setup build test bench fuzz demo config format format-check lint clean help
 
 all: build
 
@@ -23,6 +23,7 @@ help:
 	@echo "make bench         setup + build + benchmarks (timings, memory, accuracy tables)"
 	@echo "make fuzz          libFuzzer: LMS111 bytes and recordings, cloud/JSON files, Ensemble replies (FUZZ_SECONDS=60 each)"
 	@echo "make demo          setup + build + a synthetic tree scanned, modeled and scored -> results/"
+	@echo "make config        rewrite config/*.yaml and docs/configuration.md from the parameter tables"
 	@echo "make format        clang-format the sources in place"
 	@echo "make format-check  fail on any badly formatted source; check the core has no ROS"
 	@echo "make clean         remove the build (keeps installed packages)"
@@ -54,6 +55,9 @@ fuzz:
 
 demo: build
 	bash scripts/demo.sh
+
+config: build
+	$(BUILD)/devel/lib/dormant_tree_modeling/config_reference --write $(ROOT)
 
 format: setup
 	clang-format -i $(SOURCES)

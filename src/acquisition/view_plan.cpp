@@ -2,8 +2,8 @@
 
 #include <cmath>
 
+#include "dormant_tree_modeling/common/config_table.h"
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/common/yaml_map.h"
 #include "dormant_tree_modeling/geometry/stage_kinematics.h"
 
 namespace dormant_tree_modeling {
@@ -14,6 +14,34 @@ void require(bool ok, const std::string& what) {
   if (!ok)
     throw Error(ErrorCode::INVALID_ARGUMENT, "view plan: " + what);
 }
+
+ConfigTable<ViewPlanConfig> makeTable() {
+  using V = ViewPlanConfig;
+  ConfigTable<V> t("view plan parameter", "");
+  t.add("heights_m", &V::heights_m, 0.1, 10.0, "Laser heights above the ground.")
+      .formerly("heights")
+      .add("positions_per_height", &V::positions_per_height, 1, 100,
+           "Platform positions along the row at each height.")
+      .add("position_spacing_m", &V::position_spacing_m, 0.0, 10.0,
+           "Between platform positions, along the row.")
+      .formerly("position_spacing")
+      .add("slide_steps", &V::slide_steps, 1, 1000, "Views per platform position.")
+      .add("slide_step_m", &V::slide_step_m, 0.0, 2.0,
+           "Slide move between views, centred on the slide; the travel is at most 2 m.")
+      .formerly("slide_step")
+      .add("standoff_m", &V::standoff_m, 0.5, 20.0,
+           "Horizontal distance from the row to the rotation axis (the LMS111 sees from 0.5 m).")
+      .formerly("standoff")
+      .add("front", &V::front, "Scan from the front (y < 0).")
+      .add("back", &V::back, "Scan from the back (y > 0).")
+      .add("theta_min_deg", &V::theta_min_deg, -180.0, 180.0,
+           "Rotary sweep: theta_min_deg <= theta < theta_max_deg.")
+      .add("theta_max_deg", &V::theta_max_deg, -180.0, 180.0, "End of the rotary sweep.")
+      .add("theta_step_deg", &V::theta_step_deg, 0.01, 90.0,
+           "One scan line per step (0.45: 200 lines).");
+  return t;
+}
+
 }  // namespace
 
 int ViewPlanConfig::linesPerView() const {
@@ -21,19 +49,11 @@ int ViewPlanConfig::linesPerView() const {
 }
 
 void ViewPlanConfig::validate() const {
-  require(!heights.empty(), "heights must not be empty");
-  for (const double h : heights)
-    require(h > 0.0 && h < 10.0, "heights must be in (0, 10) m");
-  require(positions_per_height >= 1, "positions_per_height must be >= 1");
-  require(position_spacing >= 0.0, "position_spacing must be >= 0");
-  require(slide_steps >= 1, "slide_steps must be >= 1");
-  require(slide_step >= 0.0 && slide_step * (slide_steps - 1) <= 2.0,
-          "slide_step must be >= 0 and the slide travel at most 2 m");
-  require(standoff > 0.5, "standoff must be > 0.5 m (the LMS111 minimum range)");
+  viewPlanConfigTable().check(*this);
+  require(slide_step_m * (slide_steps - 1) <= 2.0, "the slide travel must be at most 2 m");
   require(front || back, "at least one of front/back");
-  require(theta_min_deg < theta_max_deg && theta_min_deg >= -180.0 && theta_max_deg <= 180.0,
-          "need -180 <= theta_min_deg < theta_max_deg <= 180");
-  require(theta_step_deg > 0.0 && linesPerView() >= 1, "theta_step_deg must be > 0");
+  require(theta_min_deg < theta_max_deg, "theta_min_deg must be below theta_max_deg");
+  require(linesPerView() >= 1, "the sweep must hold at least one theta_step_deg");
 }
 
 std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {
@@ -45,17 +65,17 @@ std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {
       continue;
     // Facing the tree: from the front the platform's x points to +y, from the back to -y.
     const double yaw = is_front ? M_PI / 2.0 : -M_PI / 2.0;
-    const double y = is_front ? -config.standoff : config.standoff;
-    for (const double h : config.heights) {
+    const double y = is_front ? -config.standoff_m : config.standoff_m;
+    for (const double h : config.heights_m) {
       for (int p = 0; p < config.positions_per_height; ++p) {
-        const double x = (p - 0.5 * (config.positions_per_height - 1)) * config.position_spacing;
+        const double x = (p - 0.5 * (config.positions_per_height - 1)) * config.position_spacing_m;
         for (int s = 0; s < config.slide_steps; ++s) {
           PlannedView v;
           v.index = static_cast<int>(views.size());
           v.platform_index = platform_index;
           v.side = is_front ? "front" : "back";
           v.platform = geometry::platformPose(x, y, h, yaw);
-          v.slide = (s - 0.5 * (config.slide_steps - 1)) * config.slide_step;
+          v.slide = (s - 0.5 * (config.slide_steps - 1)) * config.slide_step_m;
           views.push_back(v);
         }
         ++platform_index;
@@ -65,35 +85,14 @@ std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {
   return views;
 }
 
+const ConfigTable<ViewPlanConfig>& viewPlanConfigTable() {
+  static const ConfigTable<ViewPlanConfig> table = makeTable();
+  return table;
+}
+
 ViewPlanConfig loadViewPlan(const std::string& path) {
   ViewPlanConfig c;
-  forEachYamlEntry(path, "", "view plan key", [&c](const std::string& key, const YAML::Node& v) {
-    if (key == "heights")
-      c.heights = v.as<std::vector<double>>();
-    else if (key == "positions_per_height")
-      c.positions_per_height = v.as<int>();
-    else if (key == "position_spacing")
-      c.position_spacing = v.as<double>();
-    else if (key == "slide_steps")
-      c.slide_steps = v.as<int>();
-    else if (key == "slide_step")
-      c.slide_step = v.as<double>();
-    else if (key == "standoff")
-      c.standoff = v.as<double>();
-    else if (key == "front")
-      c.front = v.as<bool>();
-    else if (key == "back")
-      c.back = v.as<bool>();
-    else if (key == "theta_min_deg")
-      c.theta_min_deg = v.as<double>();
-    else if (key == "theta_max_deg")
-      c.theta_max_deg = v.as<double>();
-    else if (key == "theta_step_deg")
-      c.theta_step_deg = v.as<double>();
-    else
-      return false;
-    return true;
-  });
+  viewPlanConfigTable().load(path, c);
   c.validate();
   return c;
 }

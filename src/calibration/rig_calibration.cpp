@@ -71,8 +71,8 @@ std::vector<Section> pipeSections(const evaluation::Polyline& pipe, const RigSea
 /// The modeler with raw radii: no footprint, no noise part, branch radii uncorrected.
 modeling::ModelerConfig rawConfig(modeling::ModelerConfig c) {
   c.calibration = {};
-  c.ours_correct_noise_bias = true;
-  c.branch_raw_radius = true;
+  c.noise.correct_bias = true;
+  c.branches.raw_radius = true;
   c.trunk_calibration = {};
   c.branch_calibration = {};
   return c;
@@ -141,7 +141,7 @@ std::vector<RigSample> measureSections(const RigScan& scan, const modeling::Mode
                                        const RigSearch& search, double sigma,
                                        std::vector<std::string>* warnings) {
   std::vector<RigSample> out;
-  for (const Section& sec : pipeSections(scan.rig.trunk, search, raw.slice_height)) {
+  for (const Section& sec : pipeSections(scan.rig.trunk, search, raw.trunk.slice_height_m)) {
     const Eigen::Vector3d d = (sec.b - sec.a).normalized();
     const double len = (sec.b - sec.a).norm(), reach = sec.radius + search.axis_tolerance_m;
     std::vector<int> region;
@@ -531,7 +531,7 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   for (RigScan scan : scans) {
     if (scan.points.empty())
       throw Error(ErrorCode::EMPTY_INPUT, "rig scan " + scan.name + " has no points");
-    if (pipeSections(scan.rig.trunk, search, raw.slice_height).empty() ||
+    if (pipeSections(scan.rig.trunk, search, raw.trunk.slice_height_m).empty() ||
         scan.rig.primary_branches.empty()) {
       throw Error(ErrorCode::INVALID_ARGUMENT,
                   "rig of " + scan.name +

@@ -54,29 +54,6 @@ std::int32_t DriverConfig::stopUnits() const {
   return static_cast<std::int32_t>(std::lround(stop_angle_deg * 10000.0));
 }
 
-void DriverConfig::validate() const {
-  auto require = [](bool ok, const std::string& message) {
-    if (!ok)
-      throw Error(ErrorCode::INVALID_ARGUMENT, "lms111 driver: " + message);
-  };
-  require(!host.empty(), "host must not be empty");
-  require(port > 0 && port < 65536, "port must be in 1..65535, is " + std::to_string(port));
-  require((scan_frequency_hz == 25.0 && angular_resolution_deg == 0.25) ||
-              (scan_frequency_hz == 50.0 && angular_resolution_deg == 0.5),
-          "the LMS111 runs 25 Hz with 0.25 deg or 50 Hz with 0.5 deg (asked: " +
-              std::to_string(scan_frequency_hz) + " Hz, " + std::to_string(angular_resolution_deg) +
-              " deg)");
-  require(start_angle_deg >= -45.0 && stop_angle_deg <= 225.0 && start_angle_deg < stop_angle_deg,
-          "angles must satisfy -45 <= start_angle_deg < stop_angle_deg <= 225");
-  require((stopUnits() - startUnits()) % static_cast<std::int64_t>(resolutionUnits()) == 0,
-          "stop_angle_deg - start_angle_deg must be a multiple of the resolution");
-  require(connect_timeout_s > 0 && reply_timeout_s > 0 && ready_timeout_s > 0,
-          "timeouts must be > 0");
-  require(scan_timeout_periods >= 2.0, "scan_timeout_periods must be >= 2");
-  require(reconnect_min_s > 0 && reconnect_max_s >= reconnect_min_s,
-          "need 0 < reconnect_min_s <= reconnect_max_s");
-}
-
 const char* driverStateName(DriverState state) {
   switch (state) {
     case DriverState::STOPPED:

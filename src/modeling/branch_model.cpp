@@ -59,11 +59,11 @@ TrunkCoords locate(const TrunkModel& trunk, const Eigen::Vector3d& p) {
 BranchBands branchBands(const TrunkModel& trunk, const ModelerConfig& config) {
   BranchBands b;
   b.sigma = trunk.noise_sigma;
-  b.scatter = config.ours_correct_noise_bias ? trunk.scatter : 0.0;
-  b.threshold = config.cylinder_threshold;
-  if (config.ours_derive_parameters)
+  b.scatter = config.noise.correct_bias ? trunk.scatter : 0.0;
+  b.threshold = config.fit.cylinder_threshold_m;
+  if (config.noise.derive_parameters)
     b.threshold = std::max(b.threshold, noiseBand(b.sigma));
-  b.inner_gap = config.ours_branch_shell ? config.branch_inner_gap : b.threshold;
+  b.inner_gap = config.branches.shell ? config.branches.inner_gap_m : b.threshold;
   return b;
 }
 
@@ -76,7 +76,7 @@ BranchCandidates collectCandidates(const Points& pts, const TrunkModel& trunk,
                                    const BranchBands& bands) {
   const double s_lo = trunk.cylinder_ranges.front().first - SHELL_AXIAL_MARGIN;
   const double s_hi = trunk.cylinder_ranges.back().second + SHELL_AXIAL_MARGIN;
-  const bool shell = config.ours_branch_shell;
+  const bool shell = config.branches.shell;
   const int n_points = static_cast<int>(shell ? pts.size() : region.size());
   std::vector<TrunkCoords> located(n_points);
   parallelFor(n_points, [&](int k) { located[k] = locate(trunk, pts[shell ? k : region[k]]); });
@@ -88,8 +88,8 @@ BranchCandidates collectCandidates(const Points& pts, const TrunkModel& trunk,
     const double r = trunk.cylinders[c.segment].radius;
     if (c.distance <= r + bands.threshold)
       continue;  // on the trunk surface
-    if (shell && (c.distance < r + config.branch_inner_gap ||
-                  c.distance > r + config.branch_fit_length + SHELL_OUTER_MARGIN))
+    if (shell && (c.distance < r + config.branches.inner_gap_m ||
+                  c.distance > r + config.branches.fit_length_m + SHELL_OUTER_MARGIN))
       continue;
     const int i = shell ? k : region[k];
     out.index.push_back(i);
@@ -275,15 +275,15 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
     return {};
   const BranchBands bands = branchBands(trunk, config);
   const BranchCandidates candidates = collectCandidates(pts, trunk, region, config, bands);
-  const auto clusters =
-      euclideanClusters(candidates.pts, config.branch_cluster_tolerance, config.branch_min_points);
+  const auto clusters = euclideanClusters(candidates.pts, config.branches.cluster_tolerance_m,
+                                          config.branches.min_points);
   detail::BranchSearch search({index, trunk, config, bands, wire_directions}, candidates, rejected);
   search.run(clusters);
   std::vector<BranchFit> branches = std::move(search.branches());
   keepCutOffFits(search.cutFits(), trunk, bands, branches, rejected);
-  if (config.ours_constrain_ransac)
-    mergeDuplicates(branches, config.branch_merge_curved, rejected);
-  dropSparse(branches, config.branch_min_relative_points, rejected);
+  if (config.fit.constrain)
+    mergeDuplicates(branches, config.branches.merge_curved, rejected);
+  dropSparse(branches, config.branches.min_relative_points, rejected);
   return branches;
 }
 

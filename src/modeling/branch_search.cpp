@@ -186,7 +186,7 @@ void BranchSearch::run(const std::vector<std::vector<int>>& clusters) {
 }
 
 bool BranchSearch::budgetLeft() const {
-  return extractions_ < context_.config.branch_search_budget;
+  return extractions_ < context_.config.branches.search_budget;
 }
 
 /// One candidate: fit a cylinder to its near part, check it is a primary (else split or turn
@@ -194,7 +194,7 @@ bool BranchSearch::budgetLeft() const {
 void BranchSearch::examine(const Candidate& candidate) {
   const ModelerConfig& config = context_.config;
   const NearPart near = nearPart(candidate.members);
-  if (static_cast<int>(near.pts.size()) < config.branch_min_points)
+  if (static_cast<int>(near.pts.size()) < config.branches.min_points)
     return reject(candidate, near.segment, {BranchRejection::TOO_FEW_POINTS, false});
   const Cylinder& seg = context_.trunk.cylinders[near.segment];
   const auto guess = direction(near, seg);
@@ -202,27 +202,27 @@ void BranchSearch::examine(const Candidate& candidate) {
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   std::vector<int> inliers;
   auto cyl = fit(near, seg, *guess, &inliers);
-  if (!cyl || static_cast<int>(inliers.size()) < config.branch_min_points)
+  if (!cyl || static_cast<int>(inliers.size()) < config.branches.min_points)
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   if (cyl->axis.dot(guess->radial) < 0.0)
     cyl->axis = -cyl->axis;
   Eigen::Vector3d attachment;
   const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
   bool reaches_surface = true;
-  if (config.ours_constrain_ransac) {
+  if (config.fit.constrain) {
     if (auto verdict = checkDirection(candidate, *cyl, seg, *guess, gap))
       return reject(candidate, near.segment, *verdict);
     reaches_surface = reachesSurface(near);
     // A branch crossing this one near the trunk may have taken its near part out with it.
     if (!reaches_surface &&
-        !(config.branch_keep_cut_off &&
+        !(config.branches.keep_cut_off &&
           filledToSurface(*cyl, seg, context_.index, context_.bands.inner_gap, near.nearest_gap,
                           cyl->radius + context_.bands.threshold)))
       return reject(candidate, near.segment, {BranchRejection::NOT_AT_THE_SURFACE, true});
     if (auto verdict = checkPlace(candidate, *cyl, attachment))
       return reject(candidate, near.segment, *verdict);
   }
-  if (config.ours_remove_clutter &&
+  if (config.preprocess.remove_clutter &&
       looksLikeWire(*cyl, seg, context_.index, context_.bands.sigma, context_.wire_directions)) {
     // A wire passing close to a branch joins its cluster: the wire's points go, the rest is
     // looked at again.
@@ -244,7 +244,7 @@ BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) c
       near.nearest_gap = gap;
       near.segment = c.segment;
     }
-    if (gap <= context_.config.branch_fit_length) {
+    if (gap <= context_.config.branches.fit_length_m) {
       near.pts.push_back(candidates_.pts[k]);
       near.index.push_back(candidates_.index[k]);
     }
@@ -273,8 +273,9 @@ std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& n
     axis = -axis;
   const bool elongated = spread(2) > STEEP_ELONGATION * spread(1);
   const double max_angle =
-      (elongated ? config.branch_max_steep_angle : config.branch_max_radial_angle) * DEG;
-  if (config.ours_constrain_ransac && angleBetween(axis, radial) > max_angle)
+      (elongated ? config.branches.max_steep_angle_deg : config.branches.max_radial_angle_deg) *
+      DEG;
+  if (config.fit.constrain && angleBetween(axis, radial) > max_angle)
     axis = radial;
   return Direction{radial, axis, max_angle};
 }
@@ -287,22 +288,21 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   const BranchBands& bands = context_.bands;
   CylinderRansacOptions o;
   o.threshold = bands.threshold;
-  o.circle_iterations = config.ransac_iterations / 2;
+  o.circle_iterations = config.fit.ransac_iterations / 2;
   o.axis_candidates = AXIS_CANDIDATES;
-  o.max_axis_deviation =
-      config.ours_constrain_ransac ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
+  o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
   o.min_radius = MIN_BRANCH_RADIUS;
-  o.max_radius = config.ours_constrain_ransac ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius)
-                                              : PAPER_MAX_BRANCH_RADIUS;
+  o.max_radius =
+      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
   o.seed = config.seed * FIT_SEED_FACTOR + stream_++;
-  if (!config.ours_constrain_ransac)
+  if (!config.fit.constrain)
     return ransacCylinder(near.pts, guess.axis, o, inliers);
   // With a branch calibration the fit reports the raw RMS radius and the table maps it.
-  const bool calibrated = config.ours_correct_noise_bias && config.branch_calibration.valid();
-  const bool raw = calibrated || config.branch_raw_radius;
+  const bool calibrated = config.noise.correct_bias && config.branch_calibration.valid();
+  const bool raw = calibrated || config.branches.raw_radius;
   auto cyl = fitThinCylinder(near.pts, guess.axis, bands.sigma, raw ? 0.0 : bands.scatter,
                              o.max_radius, o.seed, inliers);
-  if (cyl && calibrated && !config.branch_raw_radius)
+  if (cyl && calibrated && !config.branches.raw_radius)
     cyl->radius = config.branch_calibration.correct(cyl->radius, bands.sigma, MIN_BRANCH_RADIUS);
   return cyl;
 }
@@ -321,18 +321,18 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidat
   const Eigen::Vector3d across = fit.axis - fit.axis.dot(seg.axis) * seg.axis;
   const bool sideways =
       across.norm() > MIN_ACROSS_SHARE &&
-      angleBetween(across.normalized(), guess.radial) > config.branch_max_azimuth * DEG;
+      angleBetween(across.normalized(), guess.radial) > config.branches.max_azimuth_deg * DEG;
   const bool off_ray = candidate.ray && std::acos(std::clamp(std::abs(fit.axis.dot(*candidate.ray)),
                                                              -1.0, 1.0)) > RAY_AGREEMENT;
   if (off_ray)
     return Verdict{BranchRejection::OFF_ITS_RAY, true};
   if (angleBetween(fit.axis, guess.radial) > guess.max_angle || sideways)
     return Verdict{BranchRejection::NOT_RADIAL, true};
-  if (angleBetween(fit.axis, seg.axis) > (90.0 - config.branch_min_elevation) * DEG)
+  if (angleBetween(fit.axis, seg.axis) > (90.0 - config.branches.min_elevation_deg) * DEG)
     return Verdict{BranchRejection::POINTS_DOWN, true};
-  if (fit.radius > config.branch_max_diameter_ratio * seg.radius)
+  if (fit.radius > config.branches.max_diameter_ratio * seg.radius)
     return Verdict{BranchRejection::THICKER_THAN_THE_TRUNK, true};
-  if (gap > seg.radius + config.branch_axis_gap)
+  if (gap > seg.radius + config.branches.axis_gap_m)
     return Verdict{BranchRejection::MISSES_THE_TRUNK, true};
   return std::nullopt;
 }
@@ -348,12 +348,12 @@ bool BranchSearch::reachesSurface(const NearPart& near) const {
 std::optional<BranchSearch::Verdict> BranchSearch::checkPlace(
     const Candidate& candidate, const Cylinder& fit, const Eigen::Vector3d& attachment) const {
   const ModelerConfig& config = context_.config;
-  if (fit.length < config.branch_min_length) {
+  if (fit.length < config.branches.min_length_m) {
     const bool large =
-        static_cast<int>(candidate.members.size()) >= SHORT_SPLIT * config.branch_min_points;
+        static_cast<int>(candidate.members.size()) >= SHORT_SPLIT * config.branches.min_points;
     return Verdict{BranchRejection::TOO_SHORT, large};
   }
-  if (attachment.z() - context_.trunk.baseZ() < config.branch_min_height)
+  if (attachment.z() - context_.trunk.baseZ() < config.branches.min_height_m)
     return Verdict{BranchRejection::TOO_LOW, false};
   return std::nullopt;
 }
@@ -370,7 +370,7 @@ void BranchSearch::accept(const Candidate& candidate, const NearPart& near, cons
     branch.inliers.push_back(near.index[i]);
   }
   branch.cylinder = fit;
-  if (config.ours_correct_noise_bias && !config.ours_constrain_ransac) {
+  if (config.noise.correct_bias && !config.fit.constrain) {
     branch.cylinder.radius =
         noiseCorrectedRadius(fit, in, bands.sigma, bands.threshold, MIN_BRANCH_RADIUS);
   }
@@ -385,7 +385,7 @@ void BranchSearch::accept(const Candidate& candidate, const NearPart& near, cons
         {std::move(branch), near.nearest_gap,
          rejection(candidates_.pts, candidate.members, BranchRejection::NOT_AT_THE_SURFACE)});
   }
-  if (config.ours_constrain_ransac)
+  if (config.fit.constrain)
     searchRest(candidate.members, fit);
 }
 
@@ -395,8 +395,8 @@ void BranchSearch::accept(const Candidate& candidate, const NearPart& near, cons
 void BranchSearch::reject(const Candidate& candidate, int segment, Verdict verdict) {
   const ModelerConfig& config = context_.config;
   const bool could_split =
-      verdict.splittable && config.ours_constrain_ransac &&
-      static_cast<int>(candidate.members.size()) >= SPLIT_MIN_SIZE * config.branch_min_points;
+      verdict.splittable && config.fit.constrain &&
+      static_cast<int>(candidate.members.size()) >= SPLIT_MIN_SIZE * config.branches.min_points;
   if (could_split && budgetLeft()) {
     Points cluster_pts;
     for (const int k : candidate.members)
@@ -416,17 +416,18 @@ bool BranchSearch::splitAlongRay(const Candidate& candidate, const Points& clust
                                  int segment) {
   const ModelerConfig& config = context_.config;
   const double sigma = context_.bands.sigma;
-  if (!config.branch_ray_split || sigma < config.branch_ray_split_min_noise || candidate.ray)
+  if (!config.branches.ray_split || sigma < config.branches.ray_split_min_noise_m || candidate.ray)
     return false;
-  const auto ray = strongestRay(cluster_pts, context_.trunk.cylinders[segment],
-                                config.branch_min_elevation, config.branch_max_steep_angle);
+  const auto ray =
+      strongestRay(cluster_pts, context_.trunk.cylinders[segment],
+                   config.branches.min_elevation_deg, config.branches.max_steep_angle_deg);
   if (!ray)
     return false;
   const double tube = std::max(noiseBand(sigma), RAY_MIN_BAND) + RAY_TUBE_RADIUS;
   std::vector<int> on, rest;
   for (const int k : candidate.members)
     (rayDistance(*ray, candidates_.pts[k]) < tube ? on : rest).push_back(k);
-  if (static_cast<int>(on.size()) < config.branch_min_points || rest.empty())
+  if (static_cast<int>(on.size()) < config.branches.min_points || rest.empty())
     return false;
   work_.push_back({std::move(on), ray->direction});
   ++extractions_;
@@ -457,7 +458,7 @@ std::vector<int> BranchSearch::searchRest(const std::vector<int>& cluster, const
   std::vector<int> taken, rest;
   for (const int k : cluster)
     (axisDistance(found, candidates_.pts[k]) > reach ? rest : taken).push_back(k);
-  if (static_cast<int>(rest.size()) >= REMAINDER_MIN_SIZE * context_.config.branch_min_points) {
+  if (static_cast<int>(rest.size()) >= REMAINDER_MIN_SIZE * context_.config.branches.min_points) {
     if (budgetLeft()) {
       pushParts(rest);
     } else if (rejected_) {
@@ -475,8 +476,8 @@ void BranchSearch::pushParts(const std::vector<int>& rest) {
   for (const int k : rest)
     rest_pts.push_back(candidates_.pts[k]);
   const ModelerConfig& config = context_.config;
-  for (const auto& part :
-       euclideanClusters(rest_pts, config.branch_cluster_tolerance, config.branch_min_points)) {
+  for (const auto& part : euclideanClusters(rest_pts, config.branches.cluster_tolerance_m,
+                                            config.branches.min_points)) {
     std::vector<int> mapped;
     for (const int k : part)
       mapped.push_back(rest[k]);

@@ -71,7 +71,7 @@ RejectedBranch rejection(const Points& pts, const std::vector<int>& members, Bra
 
 /// @brief The work list of the search: clusters, the parts a fused cluster was split into, and
 /// what is left of a cluster once a branch or a wire was taken out of it, within a budget of
-/// such extractions (config.branch_search_budget).
+/// such extractions (config.branches.search_budget).
 class BranchSearch {
  public:
   /// @param rejected when given, receives every candidate turned down

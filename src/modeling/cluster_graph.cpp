@@ -56,16 +56,16 @@ void updateCluster(const Points& pts, Cluster& c) {
 
 std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config,
                                      double spacing) {
-  std::size_t per_cluster = static_cast<std::size_t>(config.cluster_points);
-  if (config.ours_derive_parameters && spacing > 0.0) {
+  std::size_t per_cluster = static_cast<std::size_t>(config.graph.points_per_cluster);
+  if (config.noise.derive_parameters && spacing > 0.0) {
     // N_c from density: a cluster about 15 cm across, whatever the scanner's point spacing
     // (the paper's 3000 points fit its density, not a sparse terrestrial scan).
     const double by_density = (0.15 / spacing) * (0.15 / spacing);
     per_cluster = static_cast<std::size_t>(
-        std::clamp(by_density, 30.0, static_cast<double>(config.cluster_points)));
+        std::clamp(by_density, 30.0, static_cast<double>(config.graph.points_per_cluster)));
   }
   const int k = std::max(1, static_cast<int>(pts.size() / per_cluster));
-  const auto labels = kMeans(pts, k, config.kmeans_iterations, config.seed);
+  const auto labels = kMeans(pts, k, config.graph.kmeans_iterations, config.seed);
   int count = 0;
   for (const int l : labels)
     count = std::max(count, l + 1);
@@ -102,7 +102,8 @@ std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clust
     std::vector<char> split(n, 0);
     int budget = MAX_CLUSTERS - static_cast<int>(done.size() + wave.size());
     for (int c = 0; c < n; ++c) {
-      const bool small = static_cast<int>(wave[c].members.size()) < 2 * config.min_cluster_points;
+      const bool small =
+          static_cast<int>(wave[c].members.size()) < 2 * config.graph.min_cluster_points;
       if (wave[c].error > e_t && !small && budget > 0) {
         split[c] = 1;
         --budget;
@@ -116,7 +117,7 @@ std::vector<Cluster> splitClusters(const Points& pts, std::vector<Cluster> clust
       const std::uint64_t seed = config.seed + 101 +
                                  static_cast<std::uint64_t>(members.front()) * 1000003ULL +
                                  members.size();
-      const auto labels = kMeans(gather(pts, members), 2, config.kmeans_iterations, seed);
+      const auto labels = kMeans(gather(pts, members), 2, config.graph.kmeans_iterations, seed);
       for (std::size_t i = 0; i < labels.size(); ++i)
         halves[c][labels[i]].members.push_back(members[i]);
       if (halves[c][1].members.empty()) {
@@ -214,7 +215,7 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const PointInde
     }
     if (best_point < 0)
       return 0.0;
-    const auto nn = all.nearest(pts[best_point], config.graph_neighbors);
+    const auto nn = all.nearest(pts[best_point], config.graph.neighbors);
     int inside = 0;
     for (const int j : nn)
       inside += owner[j] == to;
@@ -230,10 +231,10 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const PointInde
         continue;
       }
       const double a = share(i, k);
-      if (a < config.n_low || a > config.n_high)
+      if (a < config.graph.n_low || a > config.graph.n_high)
         continue;
       const double b = share(k, i);
-      if (b < config.n_low || b > config.n_high)
+      if (b < config.graph.n_low || b > config.graph.n_high)
         continue;
       linked[i].push_back(k);
     }
@@ -250,8 +251,9 @@ std::vector<std::vector<int>> connectClusters(const Points& pts, const PointInde
 
 bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& config) {
   return cluster.centroid.z() <= zmin + TRUNK_BASE_BAND_M &&
-         static_cast<int>(cluster.members.size()) >= 2 * config.min_cluster_points && cluster.fit &&
-         std::abs(cluster.fit->axis.z()) >= std::cos(config.trunk_max_tilt * DEG);
+         static_cast<int>(cluster.members.size()) >= 2 * config.graph.min_cluster_points &&
+         cluster.fit &&
+         std::abs(cluster.fit->axis.z()) >= std::cos(config.trunk.max_tilt_deg * DEG);
 }
 
 // Algorithm 2 as the paper writes it: one walk up the cluster graph from the trunk base.
@@ -261,7 +263,7 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
   const int n = static_cast<int>(clusters.size());
   if (n == 0)
     return TrunkPath{};
-  const double psi_t = config.psi_t * DEG;
+  const double psi_t = config.graph.psi_t_deg * DEG;
   auto radius = [&](int c) { return clusters[c].fit ? clusters[c].fit->radius : 0.0; };
   // Steps 5 and 6 from one start cluster.
   auto walk = [&](int start) {
@@ -288,7 +290,7 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
         if (psi >= psi_t)
           continue;
         double score = psi;
-        if (config.ours_follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
+        if (config.graph.follow_diameter && r_ref > 0.0 && radius(k) > 0.0) {
           score = psi / psi_t + std::abs(std::log(radius(k) / r_ref));
         }
         if (score < best) {
@@ -320,7 +322,7 @@ TrunkPath findTrunkPath(const std::vector<Cluster>& clusters,
       lowest = c;
     }
   }
-  if (!config.ours_follow_diameter)
+  if (!config.graph.follow_diameter)
     return walk(lowest);
   // Ours: every sizeable, near-vertical cylinder piece near the bottom is a candidate base (a
   // post or a neighbour's low branch can be lower than the target's base); the one whose walk

@@ -80,9 +80,10 @@ Points2 noisySlice(double r, double sigma, Rng& rng) {
 CircleRansacOptions sliceOptions(const ModelerConfig& config, double r, double sigma,
                                  std::uint64_t seed) {
   CircleRansacOptions o;
-  o.threshold = config.ours_derive_parameters ? std::max(config.circle_threshold, noiseBand(sigma))
-                                              : config.circle_threshold;
-  o.iterations = config.ransac_iterations;
+  o.threshold = config.noise.derive_parameters
+                    ? std::max(config.fit.circle_threshold_m, noiseBand(sigma))
+                    : config.fit.circle_threshold_m;
+  o.iterations = config.fit.ransac_iterations;
   o.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * r);
   o.max_radius = SLICE_MAX_RADIUS_SHARE * r;
   o.seed = seed;
@@ -201,8 +202,9 @@ RadiusCalibration cached(const Key& key, const std::function<RadiusCalibration()
 }  // namespace
 
 RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {
-  const auto key = std::make_tuple(TRUNK_TABLE, config.circle_threshold, config.ransac_iterations,
-                                   config.ours_derive_parameters, config.seed);
+  const auto key =
+      std::make_tuple(TRUNK_TABLE, config.fit.circle_threshold_m, config.fit.ransac_iterations,
+                      config.noise.derive_parameters, config.seed);
   return cached(key, [&] {
     return tabulate(
         config, TRUNK_RADII_M, config.seed * 104729ULL,
@@ -211,8 +213,9 @@ RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {
 }
 
 RadiusCalibration branchNoiseBias(const ModelerConfig& config) {
-  const auto key = std::make_tuple(BRANCH_TABLE, config.circle_threshold, config.ransac_iterations,
-                                   config.ours_derive_parameters, config.seed);
+  const auto key =
+      std::make_tuple(BRANCH_TABLE, config.fit.circle_threshold_m, config.fit.ransac_iterations,
+                      config.noise.derive_parameters, config.seed);
   return cached(key,
                 [&] { return tabulate(config, BRANCH_RADII_M, config.seed * 130363ULL, rodBias); });
 }

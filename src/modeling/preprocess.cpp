@@ -482,15 +482,15 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
       std::remove_copy_if(pts.begin(), pts.end(), std::back_inserter(bulk), far);
     }
   }
-  s.voxel_size = config.voxel_size;
+  s.voxel_size = config.preprocess.voxel_size_m;
   Points out = voxelDownsample(s.far_outliers > 0 ? bulk : pts, s.voxel_size);
   Points().swap(bulk);
   s.after_voxel = out.size();
-  if (config.ours_remove_clutter) {
-    double radius = config.floating_radius;
+  if (config.preprocess.remove_clutter) {
+    double radius = config.preprocess.floating_radius_m;
     // One grid for the spacing and, when the radius stays the configured one, the counts.
     std::optional<detail::CellKeys> grid;
-    if (config.ours_derive_parameters && out.size() >= 2) {
+    if (config.noise.derive_parameters && out.size() >= 2) {
       // Sparse clouds (terrestrial scans of whole trees, a few cm between returns) would lose
       // everything to a fixed radius: scale it with the median nearest-neighbour spacing.
       grid.emplace(detail::sortedByCell(out, detail::cellForRadius(radius)));
@@ -498,8 +498,8 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
     }
     s.floating_radius = radius;
     const bool reuse = grid && grid->cell >= detail::cellForRadius(radius);
-    const auto mask =
-        floatingMaskWith(out, radius, config.floating_min_neighbors, reuse ? &*grid : nullptr);
+    const auto mask = floatingMaskWith(out, radius, config.preprocess.floating_min_neighbors,
+                                       reuse ? &*grid : nullptr);
 
     Points kept;
     for (std::size_t i = 0; i < out.size(); ++i) {
@@ -509,9 +509,10 @@ Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStat
     s.floating = out.size() - kept.size();
     out.swap(kept);
     s.ground = removeGround(out, config.seed + 11);
-    s.wires = removeWires(out, config.wire_min_length, config.seed + 13, &s.wire_directions);
+    s.wires =
+        removeWires(out, config.preprocess.wire_min_length_m, config.seed + 13, &s.wire_directions);
   }
-  s.capped = capPoints(out, static_cast<std::size_t>(config.max_modeled_points), &s.voxel_size);
+  s.capped = capPoints(out, static_cast<std::size_t>(config.preprocess.max_points), &s.voxel_size);
   if (stats)
     *stats = s;
   return out;

@@ -78,7 +78,7 @@ std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t
     std::snprintf(text, sizeof(text),
                   "%zu points modeled on a %.1f mm grid, coarser than voxel_size, to stay within "
                   "max_modeled_points (%d)",
-                  modeled, 1000.0 * s.voxel_size, config.max_modeled_points);
+                  modeled, 1000.0 * s.voxel_size, config.preprocess.max_points);
     out.emplace_back(text);
   }
   return out;
@@ -110,7 +110,7 @@ DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeMod
                                       double sigma) {
   DiameterCorrection d;
   d.noise_sigma = sigma;
-  if (!config.ours_correct_noise_bias)
+  if (!config.noise.correct_bias)
     return d;
   const SensorCalibration& cal = config.calibration;
   if (!cal.given()) {
@@ -277,7 +277,7 @@ std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<i
   std::vector<double> region_s(region.size());
   parallelFor(static_cast<int>(region.size()),
               [&](int k) { region_s[k] = trunk.centerline.project(pts[region[k]]); });
-  const double band = std::max(config.cylinder_threshold, noiseBand(trunk.noise_sigma));
+  const double band = std::max(config.fit.cylinder_threshold_m, noiseBand(trunk.noise_sigma));
   std::vector<CylinderModel> out;
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
     const Cylinder& c = trunk.cylinders[i];
@@ -322,7 +322,7 @@ PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
 ModelerConfig stageConfig(const ModelerConfig& config) {
   config.validate();
   ModelerConfig c = config;
-  if (c.ours_correct_noise_bias) {
+  if (c.noise.correct_bias) {
     c.trunk_calibration = addFootprint(trunkNoiseBias(c), c.calibration.trunk_footprint);
     c.branch_calibration = addFootprint(branchNoiseBias(c), c.calibration.branch_footprint);
   }
@@ -360,11 +360,11 @@ ModelResult TreeModeler::model(const Points& input) const {
   // Algorithm 2.
   auto clusters = initialClusters(pts, config_, medianSpacing(pts, index));
   watch.lap("kmeans");
-  result.split_error = config_.ours_derive_parameters
-                           ? derivedSplitError(clusters, config_.split_error)
-                           : config_.split_error;
+  result.split_error = config_.noise.derive_parameters
+                           ? derivedSplitError(clusters, config_.graph.split_error_m)
+                           : config_.graph.split_error_m;
   clusters = splitClusters(pts, std::move(clusters), result.split_error, config_);
-  clusters = mergeClusters(pts, std::move(clusters), config_.merge_distance);
+  clusters = mergeClusters(pts, std::move(clusters), config_.graph.merge_distance_m);
   watch.lap("split_merge");
   const auto adjacency = connectClusters(pts, index, clusters, config_);
   const TrunkPath path = findTrunkPath(clusters, adjacency, config_);
@@ -376,7 +376,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   // Algorithm 3 on the trunk region: Algorithm 2's, or (ours) the points around the best
   // tracked trunk.
   TrunkRegion region = pathRegion(clusters, path);
-  if (config_.ours_follow_diameter) {
+  if (config_.graph.follow_diameter) {
     if (const auto tracked =
             trackBestTrunk(pts, index, clusters, path, config_, &result.trunk_candidates)) {
       region.axis = tracked->centers;

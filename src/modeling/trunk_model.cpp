@@ -124,7 +124,7 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
       plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
     CircleRansacOptions o;
     o.threshold = threshold;
-    o.iterations = config.ransac_iterations;
+    o.iterations = config.fit.ransac_iterations;
     o.min_radius = bounds.min_radius;
     o.max_radius = bounds.max_radius;
     if (expected_radius && (*expected_radius)[n] > 0.0) {
@@ -133,8 +133,8 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     }
 
     o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
-    const auto measured = measureSliceCircle(plane, o, config.ours_correct_noise_bias,
-                                             bounds.min_radius, bounds.max_radius);
+    const auto measured = measureSliceCircle(plane, o, config.noise.correct_bias, bounds.min_radius,
+                                             bounds.max_radius);
     sl.outliers = sl.points - (measured ? measured->inliers : 0);
     sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
     if (measured && measured->inliers >= MIN_SLICE_POINTS / 2) {
@@ -259,21 +259,21 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
     axis = Eigen::Vector3d::UnitZ();
   CylinderRansacOptions o;
   o.threshold = threshold;
-  o.circle_iterations = config.ransac_iterations;
+  o.circle_iterations = config.fit.ransac_iterations;
   o.seed = config.seed * 104729 + stream;
   o.min_radius = bounds.min_radius;
   o.max_radius = bounds.max_radius;
   o.max_axis_deviation = 35.0 * DEG;
-  if (config.ours_constrain_ransac) {
+  if (config.fit.constrain) {
     std::vector<double> r;
     for (const auto& sl : slices) {
-      if (sl.has_circle && sl.s0 + 1e-9 >= a - 0.5 * config.slice_height && sl.s0 < b)
+      if (sl.has_circle && sl.s0 + 1e-9 >= a - 0.5 * config.trunk.slice_height_m && sl.s0 < b)
         r.push_back(sl.radius);
     }
     const double expected = median(r);
     if (expected > 0.0) {
-      o.min_radius = std::max(MIN_TRUNK_RADIUS, expected * (1.0 - config.radius_continuity));
-      o.max_radius = expected * (1.0 + config.radius_continuity);
+      o.min_radius = std::max(MIN_TRUNK_RADIUS, expected * (1.0 - config.trunk.radius_continuity));
+      o.max_radius = expected * (1.0 + config.trunk.radius_continuity);
     }
     o.max_axis_deviation = 10.0 * DEG;
   }
@@ -281,19 +281,19 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
   auto cyl = ransacCylinder(sub, axis, o, &inliers);
   if (!cyl)
     return std::nullopt;
-  if (config.ours_constrain_ransac &&
-      std::acos(std::clamp(cyl->axis.z(), -1.0, 1.0)) > config.trunk_max_tilt * DEG) {
+  if (config.fit.constrain &&
+      std::acos(std::clamp(cyl->axis.z(), -1.0, 1.0)) > config.trunk.max_tilt_deg * DEG) {
     return std::nullopt;
   }
   if (cyl->axis.z() < 0.0)
     cyl->axis = -cyl->axis;
-  if (config.ours_correct_noise_bias) {
+  if (config.noise.correct_bias) {
     // Median over the segment's slices of their noise-corrected radii: slices at branch
     // junctions, whose points include the branch's base, are the minority.
     std::vector<double> r;
     for (const auto& sl : slices) {
-      if (sl.has_circle && sl.s0 + 0.5 * config.slice_height >= a &&
-          sl.s0 + 0.5 * config.slice_height < b) {
+      if (sl.has_circle && sl.s0 + 0.5 * config.trunk.slice_height_m >= a &&
+          sl.s0 + 0.5 * config.trunk.slice_height_m < b) {
         r.push_back(sl.corrected_radius);
       }
     }
@@ -381,7 +381,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
                         const Eigen::Vector3d& direction, double radius, double threshold,
                         const ModelerConfig& config, int max_misses, bool trust_radius) {
   TrackedTrunk out;
-  const double h = config.slice_height;
+  const double h = config.trunk.slice_height_m;
   Eigen::Vector3d c = start, t = direction.normalized();
   double r = std::clamp(radius, MIN_TRUNK_RADIUS, MAX_TRUNK_RADIUS);
   int misses = 0;
@@ -401,7 +401,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     }
     CircleRansacOptions o;
     o.threshold = threshold;
-    o.iterations = config.ransac_iterations;
+    o.iterations = config.fit.ransac_iterations;
     o.min_radius = first ? MIN_TRUNK_RADIUS : std::max(MIN_TRUNK_RADIUS, 0.6 * r);
     o.max_radius =
         first ? std::max(1.25 * r, 0.5 * FIRST_WINDOW) : (out.centers.empty() ? 1.6 : 1.25) * r;
@@ -554,7 +554,7 @@ std::optional<double> curvatureCut(const Points& pts, const std::vector<int>& re
                                    const SliceBounds& bounds, const Cylinder& cyl, double a,
                                    double b, double cylinder_threshold,
                                    const ModelerConfig& config) {
-  const int bins = std::max(2, static_cast<int>((b - a) / config.slice_height));
+  const int bins = std::max(2, static_cast<int>((b - a) / config.trunk.slice_height_m));
   std::vector<int> in(bins, 0), all(bins, 0);
   for (std::size_t k = 0; k < region.size(); ++k) {
     if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance)
@@ -571,12 +571,13 @@ std::optional<double> curvatureCut(const Points& pts, const std::vector<int>& re
     const double j =
         std::abs(static_cast<double>(in[k]) / all[k] - static_cast<double>(in[k - 1]) / all[k - 1]);
     const double cut = a + (b - a) * k / bins;
-    if (j > jump && cut - a >= config.min_segment_length && b - cut >= config.min_segment_length) {
+    if (j > jump && cut - a >= config.trunk.min_segment_length_m &&
+        b - cut >= config.trunk.min_segment_length_m) {
       jump = j;
       at = k;
     }
   }
-  if (at > 0 && jump > config.curvature_jump)
+  if (at > 0 && jump > config.trunk.curvature_jump)
     return a + (b - a) * at / bins;
   return std::nullopt;
 }
@@ -593,7 +594,7 @@ std::vector<double> splitAtCurvature(const Points& pts, const std::vector<int>& 
   std::uint64_t stream = 0;
   for (std::size_t i = 1; i < cuts.size(); ++i) {
     const double a = out.back(), b = cuts[i];
-    if (b - a >= 2.0 * config.min_segment_length) {
+    if (b - a >= 2.0 * config.trunk.min_segment_length_m) {
       if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices,
                                       cylinder_threshold, scatter, config, stream++)) {
         if (const auto cut =
@@ -657,12 +658,12 @@ SliceBounds sliceBounds(double initial_radius) {
 /// The region's range noise: the configured one, or estimated from the slices.
 double trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
                   const std::vector<Slice>& slices, const ModelerConfig& config) {
-  if (config.noise_sigma >= 0.0)
-    return config.noise_sigma;
+  if (config.noise.sigma_m >= 0.0)
+    return config.noise.sigma_m;
   Points region_pts;
   for (const int i : region)
     region_pts.push_back(pts[i]);
-  const double estimate = estimateNoiseSigma(region_pts, line, slices, config.slice_height);
+  const double estimate = estimateNoiseSigma(region_pts, line, slices, config.trunk.slice_height_m);
   return estimate > 0.0 ? estimate : 0.0;
 }
 
@@ -673,28 +674,28 @@ std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
                               const SliceBounds& bounds, const Centerline& line,
                               const std::vector<Slice>& slices, double cylinder_threshold,
                               double scatter, const ModelerConfig& config) {
-  const double h = config.slice_height;
+  const double h = config.trunk.slice_height_m;
   double top = 0.0;
   for (const auto& sl : slices) {
     if (sl.points >= MIN_SLICE_POINTS)
       top = std::max(top, sl.s0 + h);
   }
   const auto joined =
-      joinShortSegments(disturbancePartitions(slices, h, config.disturbance_zero_run, top),
-                        config.min_segment_length);
+      joinShortSegments(disturbancePartitions(slices, h, config.trunk.disturbance_zero_run, top),
+                        config.trunk.min_segment_length_m);
   std::vector<double> cuts = splitAtCurvature(pts, region, s, dist, bounds, line, slices, joined,
                                               cylinder_threshold, scatter, config);
-  if (config.trunk_max_bend > 0.0) {
+  if (config.trunk.max_bend_m > 0.0) {
     std::vector<double> straight{cuts.front()};
     for (std::size_t i = 1; i < cuts.size(); ++i) {
-      splitAtBends(line, straight.back(), cuts[i], h, config.trunk_max_bend,
-                   config.min_segment_length, straight);
+      splitAtBends(line, straight.back(), cuts[i], h, config.trunk.max_bend_m,
+                   config.trunk.min_segment_length_m, straight);
       straight.push_back(cuts[i]);
     }
     cuts = std::move(straight);
   }
-  if (config.trunk_max_segment_length > 0.0)
-    cuts = splitLongSegments(cuts, config.trunk_max_segment_length);
+  if (config.trunk.max_segment_length_m > 0.0)
+    cuts = splitLongSegments(cuts, config.trunk.max_segment_length_m);
   return cuts;
 }
 
@@ -712,9 +713,9 @@ void fitCylinders(const Points& pts, const std::vector<int>& region, const std::
                               cylinder_threshold, scatter, config, SEGMENT_SEED_BASE + i)) {
       trunk.cylinders.push_back(*cyl);
       trunk.cylinder_ranges.emplace_back(a, b);
-    } else if (config.ours_follow_diameter) {
-      if (auto chord =
-              segmentFromSlices(trunk.slices, trunk.centerline, a, b, config.slice_height)) {
+    } else if (config.graph.follow_diameter) {
+      if (auto chord = segmentFromSlices(trunk.slices, trunk.centerline, a, b,
+                                         config.trunk.slice_height_m)) {
         trunk.cylinders.push_back(*chord);
         trunk.cylinder_ranges.emplace_back(a, b);
       }
@@ -725,7 +726,7 @@ void fitCylinders(const Points& pts, const std::vector<int>& region, const std::
 /// The cylinders' radii from a taper profile fitted to the slices, when one fits.
 void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
   const auto profile =
-      TaperProfile::fit(trunk.slices, config.slice_height, TAPER_BELOW,
+      TaperProfile::fit(trunk.slices, config.trunk.slice_height_m, TAPER_BELOW,
                         trunk.noise_sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE);
   if (!profile)
     return;
@@ -744,36 +745,36 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     throw Error(ErrorCode::NO_TRUNK, "no trunk: too few trunk points to model");
   }
   TrunkModel trunk;
-  const double h = config.slice_height;
+  const double h = config.trunk.slice_height_m;
   Centerline line(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   std::vector<double> s(region.size()), dist(region.size());
   projectRegion(pts, region, line, s, dist);
   const SliceBounds bounds = sliceBounds(initial_radius);
   // Slices on the initial axis refine the centreline; then the noise is estimated.
-  auto slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds,
+  auto slices = computeSlices(pts, region, line, s, dist, h, config.fit.circle_threshold_m, bounds,
                               nullptr, 0.0, std::nullopt, config);
   for (int round = 0; round < CENTERLINE_ROUNDS; ++round) {
     line = refineCenterline(slices, line, std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
     projectRegion(pts, region, line, s, dist);
-    slices = computeSlices(pts, region, line, s, dist, h, config.circle_threshold, bounds, nullptr,
-                           0.0, std::nullopt, config);
+    slices = computeSlices(pts, region, line, s, dist, h, config.fit.circle_threshold_m, bounds,
+                           nullptr, 0.0, std::nullopt, config);
   }
   const double sigma = trunkNoise(pts, region, line, slices, config);
   trunk.noise_sigma = sigma;
   const double scatter =
-      config.ours_correct_noise_bias ? std::hypot(sigma, config.beam_spread) : 0.0;
+      config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;
   trunk.scatter = scatter;
-  double circle_threshold = config.circle_threshold, cylinder_threshold = config.cylinder_threshold;
-  if (config.ours_derive_parameters) {
+  double circle_threshold = config.fit.circle_threshold_m,
+         cylinder_threshold = config.fit.cylinder_threshold_m;
+  if (config.noise.derive_parameters) {
     circle_threshold = std::max(circle_threshold, noiseBand(sigma));
     cylinder_threshold = std::max(cylinder_threshold, noiseBand(sigma));
   }
-  if (config.ours_constrain_ransac || config.ours_derive_parameters ||
-      config.ours_correct_noise_bias) {
+  if (config.fit.constrain || config.noise.derive_parameters || config.noise.correct_bias) {
     const auto expected = expectedRadii(slices);
     slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
-                           config.ours_constrain_ransac ? &expected : nullptr,
-                           config.radius_continuity, sigma, config);
+                           config.fit.constrain ? &expected : nullptr,
+                           config.trunk.radius_continuity, sigma, config);
   }
   trunk.slices = slices;
   trunk.centerline = line;
@@ -782,9 +783,9 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   fitCylinders(pts, region, s, dist, bounds, cylinder_threshold, scatter, config, trunk);
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
-  if (config.ours_correct_noise_bias && config.trunk_taper_profile)
+  if (config.noise.correct_bias && config.trunk.taper_profile)
     applyTaperProfile(trunk, config);
-  if (config.ours_constrain_ransac)
+  if (config.fit.constrain)
     boundByTheSegmentBelow(trunk.cylinders);
   return trunk;
 }

@@ -105,7 +105,7 @@ double trackingThreshold(const Points& pts, const std::vector<Cluster>& clusters
     if (s.cluster >= 0 && clusters[s.cluster].fit)
       guesses.push_back(noiseGuess(pts, clusters[s.cluster]));
   }
-  return std::max(0.5 * config.circle_threshold, noiseBand(median(guesses)));
+  return std::max(0.5 * config.fit.circle_threshold_m, noiseBand(median(guesses)));
 }
 
 /// Up from the start, retried from the start's own radius when a wide first circle stopped it
@@ -379,7 +379,7 @@ std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
   std::vector<Eigen::Vector2d> peaks;
   std::vector<TrunkStart> out;
   for (const auto& [key, cell] : order) {
-    if (cell->smoothed < 2 * config.min_cluster_points ||
+    if (cell->smoothed < 2 * config.graph.min_cluster_points ||
         static_cast<int>(out.size()) >= COLUMN_STARTS)
       break;
     const Eigen::Vector2d xy((key.x + 0.5) * COLUMN_CELL_M, (key.y + 0.5) * COLUMN_CELL_M);

@@ -52,7 +52,7 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
   // The silhouette from a slab of the patch (the ball would cut its edges short). Beams fan
   // evenly across a branch, so the offsets across are uniform over the silhouette: its width is
   // sqrt(12) standard deviations, however densely the station's views sampled it.
-  const double slab = 0.25 * c.patch;
+  const double slab = 0.25 * c.patch_m;
   std::vector<int> in_slab;
   double sum = 0, sum_sq = 0;
   for (std::size_t i = 0; i < patch.size(); ++i) {
@@ -71,7 +71,7 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
   const double width = std::sqrt(12.0 * std::max(sum_sq / n - mid * mid, 0.0));
   const double range = median(patch_ranges);
   const double radius = 0.5 * (width - c.silhouette_growth_m - c.silhouette_growth_per_m * range);
-  if (!(radius >= c.min_radius && radius <= c.max_radius))
+  if (!(radius >= c.min_radius_m && radius <= c.max_radius_m))
     return std::nullopt;
   // A point at offset x from the axis (across) lies sqrt(r^2 - x^2) in front of it; beams
   // grazing the edge report the edge itself. The median of what is left is the axis depth.
@@ -88,23 +88,6 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
 
 }  // namespace
 
-void AxisConfig::validate() const {
-  auto require = [](bool ok, const char* m) {
-    if (!ok)
-      throw Error(ErrorCode::INVALID_ARGUMENT, std::string("branch axes: ") + m);
-  };
-  require(patch > 0, "axis_patch must be > 0");
-  require(min_points >= 5, "axis_min_points must be >= 5");
-  require(linearity >= 1, "axis_linearity must be >= 1");
-  require(max_view_cos >= 0 && max_view_cos <= 1, "axis_max_view_cos must be in [0, 1]");
-  require(min_view_agreement >= 0 && min_view_agreement <= 1,
-          "axis_min_view_agreement must be in [0, 1]");
-  require(min_radius >= 0 && max_radius > min_radius,
-          "axis radii need 0 <= axis_min_radius < axis_max_radius");
-  require(std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
-          "silhouette growth must be within +/-0.05 m and +/-0.05 m per m");
-}
-
 AxisSamples estimateAxes(const Points& pts, const Points& view_dirs,
                          const std::vector<double>& ranges, const Points& centres,
                          const AxisConfig& c) {
@@ -118,7 +101,7 @@ AxisSamples estimateAxes(const Points& pts, const Points& view_dirs,
   const modeling::PointIndex index(pts);
   std::vector<std::optional<Sample>> found(centres.size());
   parallelFor(static_cast<int>(centres.size()), [&](int i) {
-    found[i] = fitPatch(pts, view_dirs, ranges, index.within(centres[i], 0.5 * c.patch), c);
+    found[i] = fitPatch(pts, view_dirs, ranges, index.within(centres[i], 0.5 * c.patch_m), c);
   });
   for (const auto& s : found) {
     if (!s)

@@ -167,7 +167,7 @@ std::vector<int> heightShifts(const Points& source, const Points& target, const 
     if (k >= 0 && k < PROFILE_SLABS)
       tgt[k] += 1;
   }
-  const int zmax = static_cast<int>(std::ceil(c.z_window_unhinted / grid.slab));
+  const int zmax = static_cast<int>(std::ceil(c.z_window_unhinted_m / grid.slab));
   std::vector<std::pair<double, int>> corr;
   for (int dz = -zmax; dz <= zmax; ++dz) {
     double sum = 0;
@@ -217,8 +217,8 @@ SourceColumns sourceColumns(const Points& source, const Columns& grid,
 Shift bestShift(const Points& source, const Columns& grid, double yaw, const Eigen::Vector3d& base,
                 const std::vector<int>& dzs, const CoarseSearchConfig& c) {
   const Eigen::Isometry3d pose = poseOf(yaw, base);
-  const SourceColumns cols = sourceColumns(source, grid, pose, c.cell);
-  const int w = static_cast<int>(std::ceil(c.xy_window / c.cell));
+  const SourceColumns cols = sourceColumns(source, grid, pose, c.cell_m);
+  const int w = static_cast<int>(std::ceil(c.xy_window_m / c.cell_m));
   Shift s;
   s.yaw = yaw;
   for (const int dz : dzs) {
@@ -234,9 +234,9 @@ Shift bestShift(const Points& source, const Columns& grid, double yaw, const Eig
         const double score = static_cast<double>(hits) / std::max(cols.occupied, 1);
         if (score > s.score ||
             (score == s.score &&
-             dx * dx + dy * dy < s.translation.head<2>().squaredNorm() / (c.cell * c.cell))) {
+             dx * dx + dy * dy < s.translation.head<2>().squaredNorm() / (c.cell_m * c.cell_m))) {
           s.score = score;
-          s.translation = Eigen::Vector3d(dx * c.cell, dy * c.cell, dz * grid.slab);
+          s.translation = Eigen::Vector3d(dx * c.cell_m, dy * c.cell_m, dz * grid.slab);
         }
       }
     }
@@ -273,7 +273,7 @@ std::vector<Shift> distinctHeadings(const std::vector<Shift>& best, const Coarse
 // by the share of source points in the target's dilated cells.
 CoarseCandidate refineIn3d(const Points& source, const std::unordered_set<std::uint64_t>& cells3,
                            const Shift& shift, const CoarseSearchConfig& c) {
-  const int zs = static_cast<int>(std::ceil(c.z_window / c.z_step));
+  const int zs = static_cast<int>(std::ceil(c.z_window_m / c.z_step_m));
   const Eigen::Isometry3d pose = poseOf(shift.yaw, shift.translation);
   Points moved;
   moved.reserve(source.size());
@@ -283,13 +283,13 @@ CoarseCandidate refineIn3d(const Points& source, const std::unordered_set<std::u
   for (int iz = -zs; iz <= zs; ++iz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const Eigen::Vector3d d(dx * c.cell * REFINE_XY_SHARE, dy * c.cell * REFINE_XY_SHARE,
-                                iz * c.z_step);
+        const Eigen::Vector3d d(dx * c.cell_m * REFINE_XY_SHARE, dy * c.cell_m * REFINE_XY_SHARE,
+                                iz * c.z_step_m);
         int hits = 0;
         for (const auto& q : moved) {
           const Eigen::Vector3d r = q + d;
           hits += cells3.count(
-              key3(cellOf(r.x(), c.cell), cellOf(r.y(), c.cell), cellOf(r.z(), c.cell)));
+              key3(cellOf(r.x(), c.cell_m), cellOf(r.y(), c.cell_m), cellOf(r.z(), c.cell_m)));
         }
         const double score = static_cast<double>(hits) / moved.size();
         if (score > best.score) {
@@ -304,29 +304,16 @@ CoarseCandidate refineIn3d(const Points& source, const std::unordered_set<std::u
 
 }  // namespace
 
-void CoarseSearchConfig::validate() const {
-  auto require = [](bool ok, const char* m) {
-    if (!ok)
-      throw Error(ErrorCode::INVALID_ARGUMENT, std::string("coarse search: ") + m);
-  };
-  require(cell > 0, "cell must be > 0");
-  require(yaw_window_deg >= 0 && yaw_window_deg <= 180, "yaw_window_deg must be in [0, 180]");
-  require(yaw_step_deg > 0, "yaw_step_deg must be > 0");
-  require(xy_window >= 0 && z_window >= 0 && z_window_unhinted >= 0, "windows must be >= 0");
-  require(z_step > 0, "z_step must be > 0");
-  require(candidates >= 1, "candidates must be >= 1");
-}
-
 std::vector<CoarseCandidate> coarseSearch(const Points& source_in, const Points& target_in,
                                           const std::optional<Eigen::Isometry3d>& hint,
                                           const CoarseSearchConfig& c) {
   c.validate();
-  const Points source = modeling::voxelDownsample(source_in, c.cell);
-  const Points target = modeling::voxelDownsample(target_in, c.cell);
+  const Points source = modeling::voxelDownsample(source_in, c.cell_m);
+  const Points target = modeling::voxelDownsample(target_in, c.cell_m);
   if (source.empty() || target.empty())
     throw Error(ErrorCode::EMPTY_INPUT, "coarse search: a cloud is empty");
-  const Columns grid = columns(target, c.cell, 2 * c.cell);
-  const std::unordered_set<std::uint64_t> cells3 = dilatedCells(target, c.cell);
+  const Columns grid = columns(target, c.cell_m, 2 * c.cell_m);
+  const std::unordered_set<std::uint64_t> cells3 = dilatedCells(target, c.cell_m);
   const Placement placement{hint, mean(source), mean(target)};
   const std::vector<double> yaws = headingsToTry(hint, c);
   const std::vector<int> dzs = heightShifts(source, target, grid, placement, c);

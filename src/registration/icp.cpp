@@ -130,7 +130,7 @@ Pairs pairUp(const LevelPair& clouds, const Eigen::Isometry3d& t, const IcpConfi
   for (std::size_t i = 0; i < clouds.source.size(); ++i) {
     if (!valid[i])
       continue;
-    close += matches[i].gap <= c.overlap_distance;
+    close += matches[i].gap <= c.overlap_distance_m;
     if (!(clouds.axis_index && matches[i].across))
       pairs.used.push_back(matches[i]);
   }
@@ -205,7 +205,7 @@ Step solveStep(const LevelPair& clouds, const Pairs& pairs, const Eigen::Isometr
   const double n_pairs = static_cast<double>(pairs.used.size() + pairs.axes.size());
   const Eigen::Vector3d centre = pairCentroid(clouds, pairs, t);
   const auto huberWeight = [&](double e) {
-    return std::abs(e) <= c.huber ? 1.0 : c.huber / std::abs(e);
+    return std::abs(e) <= c.huber_m ? 1.0 : c.huber_m / std::abs(e);
   };
   NormalEquations eq;
   double sq = 0, radius_sq = 0;
@@ -252,7 +252,7 @@ Step solveStep(const LevelPair& clouds, const Pairs& pairs, const Eigen::Isometr
 // dense target keeps the planes sharp.
 void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, int level,
                 const IcpConfig& c) {
-  const int levels = static_cast<int>(c.voxels.size());
+  const int levels = static_cast<int>(c.voxels_m.size());
   const Surface& source = source_p.levels[std::max(level - 1, 0)];
   const Surface& target = target_p.levels[level];
   if (source.size() < MIN_POINTS || target.size() < MIN_POINTS)
@@ -270,13 +270,13 @@ void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, 
                          source_p.axes,
                          target_p.axes,
                          axis_index ? &*axis_index : nullptr,
-                         c.distance_factor * c.voxels[level]};
+                         c.distance_factor * c.voxels_m[level]};
   std::vector<Match> matches(source.size());
   std::vector<char> valid(source.size());
   r.converged = false;
   int small_steps = 0;
   // Coarse levels only have to hand over to the next: their steps scale with the voxel.
-  const double scale = c.voxels[level] / c.voxels.back();
+  const double scale = c.voxels_m[level] / c.voxels_m.back();
   for (int it = 0; it < c.max_iterations; ++it) {
     ++r.iterations;
     Pairs pairs = pairUp(clouds, r.transform, c, matches, valid);
@@ -292,12 +292,12 @@ void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, 
     r.transform = step.transform * r.transform;
     const double angle = step.x.head<3>().norm();
     const double shift = step.x.tail<3>().norm();
-    if (angle < scale * c.min_rotation_step * DEG && shift < scale * c.min_translation_step) {
+    if (angle < scale * c.min_rotation_step_deg * DEG && shift < scale * c.min_translation_step_m) {
       r.converged = true;
       break;
     }
-    small_steps = angle < CYCLE_STEP_FACTOR * scale * c.min_rotation_step * DEG &&
-                          shift < CYCLE_STEP_FACTOR * scale * c.min_translation_step
+    small_steps = angle < CYCLE_STEP_FACTOR * scale * c.min_rotation_step_deg * DEG &&
+                          shift < CYCLE_STEP_FACTOR * scale * c.min_translation_step_m
                       ? small_steps + 1
                       : 0;
     if (small_steps >= CYCLE_STEPS) {
@@ -309,32 +309,12 @@ void alignLevel(IcpResult& r, const Pyramid& source_p, const Pyramid& target_p, 
 
 }  // namespace
 
-void IcpConfig::validate() const {
-  auto require = [](bool ok, const char* m) {
-    if (!ok)
-      throw Error(ErrorCode::INVALID_ARGUMENT, std::string("ICP: ") + m);
-  };
-  require(!voxels.empty(), "needs at least one level");
-  for (const double v : voxels)
-    require(v > 0, "voxel sizes must be > 0");
-  require(distance_factor > 0, "distance_factor must be > 0");
-  require(max_iterations > 0, "max_iterations must be > 0");
-  require(trim > 0 && trim <= 1, "trim must be in (0, 1]");
-  require(huber > 0, "huber must be > 0");
-  require(normal_neighbors >= 5, "normal_neighbors must be >= 5");
-  require(across_cos >= -1 && across_cos <= 1, "across_cos must be in [-1, 1]");
-  require(overlap_distance > 0, "overlap_distance must be > 0");
-  require(axis_max_angle_deg > 0 && axis_max_angle_deg < 90,
-          "axis_max_angle_deg must be in (0, 90)");
-  require(min_rotation_step > 0 && min_translation_step > 0, "convergence steps must be > 0");
-}
-
 IcpResult alignPyramids(const Pyramid& source_p, const Pyramid& target_p,
                         const Eigen::Isometry3d& guess, const IcpConfig& c, int first_level,
                         int last_level) {
   c.validate();
-  const int levels = static_cast<int>(c.voxels.size());
-  if (source_p.levels.size() != c.voxels.size() || target_p.levels.size() != c.voxels.size())
+  const int levels = static_cast<int>(c.voxels_m.size());
+  if (source_p.levels.size() != c.voxels_m.size() || target_p.levels.size() != c.voxels_m.size())
     throw Error(ErrorCode::INVALID_ARGUMENT, "ICP: pyramids do not match the configured levels");
   if (last_level < 0 || last_level >= levels)
     last_level = levels - 1;
@@ -351,8 +331,8 @@ IcpResult alignPointToPlane(const Points& source, const Points& target,
   c.validate();
   if (source.size() < 10 || target.size() < 10)
     throw Error(ErrorCode::EMPTY_INPUT, "ICP needs at least 10 points in each cloud");
-  return alignPyramids(makePyramid(source, {}, c.voxels, c.normal_neighbors),
-                       makePyramid(target, {}, c.voxels, c.normal_neighbors), guess, c);
+  return alignPyramids(makePyramid(source, {}, c.voxels_m, c.normal_neighbors),
+                       makePyramid(target, {}, c.voxels_m, c.normal_neighbors), guess, c);
 }
 
 }  // namespace registration

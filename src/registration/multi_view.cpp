@@ -75,9 +75,9 @@ std::string judge(const IcpResult& fit, const RegistrationConfig& c) {
     return "only " + std::to_string(static_cast<int>(fit.overlap * 100)) +
            " % of its points lie on the other views (needs " +
            std::to_string(static_cast<int>(c.min_overlap * 100)) + " %)";
-  if (fit.rmse > c.max_rmse)
-    return "fits the other views with rmse " + metres(fit.rmse) + " (limit " + metres(c.max_rmse) +
-           ")";
+  if (fit.rmse > c.max_rmse_m)
+    return "fits the other views with rmse " + metres(fit.rmse) + " (limit " +
+           metres(c.max_rmse_m) + ")";
   return "";
 }
 
@@ -118,7 +118,7 @@ void prepareStation(Station& s, const std::vector<ViewInput>& views, const Regis
       dirs.push_back(range > 0 ? Eigen::Vector3d(d / range) : Eigen::Vector3d::Zero());
     }
   }
-  s.pyramid = makePyramid(pts, dirs, c.icp.voxels, c.icp.normal_neighbors);
+  s.pyramid = makePyramid(pts, dirs, c.icp.voxels_m, c.icp.normal_neighbors);
   if (c.icp.axis_pairs) {
     // One sample per source point of the finest ICP level (the level above the finest).
     const std::size_t centres = s.pyramid.levels.size() >= 2 ? s.pyramid.levels.size() - 2 : 0;
@@ -195,7 +195,7 @@ void placeStation(std::vector<Station>& stations, std::size_t k, const Registrat
 /// leave the others' targets. The reference moves too (the frame is fixed afterwards): held
 /// still, it would keep the others bent towards whatever error its first pairing left.
 void refinementRound(std::vector<Station>& stations, std::size_t ref, const RegistrationConfig& c) {
-  const int fine_first = static_cast<int>(c.icp.voxels.size()) - 1;
+  const int fine_first = static_cast<int>(c.icp.voxels_m.size()) - 1;
   for (std::size_t k = 0; k < stations.size(); ++k) {
     Station& s = stations[k];
     if (!s.placed || s.rejected)
@@ -259,22 +259,6 @@ RegistrationResult viewResults(const std::vector<ViewInput>& views,
 }
 
 }  // namespace
-
-void RegistrationConfig::validate() const {
-  icp.validate();
-  coarse.validate();
-  axes.validate();
-  auto require = [](bool ok, const char* m) {
-    if (!ok)
-      throw Error(ErrorCode::INVALID_ARGUMENT, std::string("registration: ") + m);
-  };
-  require(candidate_levels >= 1 && candidate_levels <= static_cast<int>(icp.voxels.size()),
-          "candidate_levels must be between 1 and the number of ICP levels");
-  require(refinement_rounds >= 0, "refinement_rounds must be >= 0");
-  require(min_points >= 10, "min_points must be >= 10");
-  require(min_overlap >= 0 && min_overlap <= 1, "min_overlap must be in [0, 1]");
-  require(max_rmse > 0, "max_rmse must be > 0");
-}
 
 RegistrationResult registerViews(const std::vector<ViewInput>& views, const RegistrationConfig& c) {
   c.validate();

@@ -2,6 +2,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -12,43 +13,15 @@ namespace {
 constexpr double RATE_TOLERANCE = 0.02;
 constexpr int RATE_WINDOW = 50;
 
-lms111::DriverConfig readConfig(ros::NodeHandle& pnh) {
-  lms111::DriverConfig c;
-  c.host = pnh.param("host", c.host);
-  c.port = pnh.param("port", c.port);
-  const std::string protocol = pnh.param<std::string>("protocol", "cola_a");
-  if (protocol != "cola_a" && protocol != "cola_b") {
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "~protocol must be cola_a or cola_b, is '" + protocol + "'");
-  }
-  c.protocol = protocol == "cola_a" ? lms111::Protocol::COLA_A : lms111::Protocol::COLA_B;
-  c.scan_frequency_hz = pnh.param("scan_frequency", c.scan_frequency_hz);
-  c.angular_resolution_deg = pnh.param("angular_resolution", c.angular_resolution_deg);
-  c.start_angle_deg = pnh.param("start_angle", c.start_angle_deg);
-  c.stop_angle_deg = pnh.param("stop_angle", c.stop_angle_deg);
-  c.rssi = pnh.param("rssi", c.rssi);
-  c.connect_timeout_s = pnh.param("connect_timeout", c.connect_timeout_s);
-  c.reply_timeout_s = pnh.param("reply_timeout", c.reply_timeout_s);
-  c.scan_timeout_periods = pnh.param("scan_timeout_periods", c.scan_timeout_periods);
-  c.ready_timeout_s = pnh.param("ready_timeout", c.ready_timeout_s);
-  c.reconnect_min_s = pnh.param("reconnect_min", c.reconnect_min_s);
-  c.reconnect_max_s = pnh.param("reconnect_max", c.reconnect_max_s);
-  c.validate();
-  return c;
-}
-
 }  // namespace
 
 Lms111DriverNode::Lms111DriverNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  const lms111::DriverConfig config = readConfig(pnh);
-  frame_id_ = pnh.param<std::string>("frame_id", "laser");
-  range_min_ = pnh.param("range_min", 0.5);
-  range_max_ = pnh.param("range_max", 20.0);
-  if (!(range_min_ >= 0.0 && range_max_ > range_min_)) {
-    throw Error(ErrorCode::INVALID_ARGUMENT, "need 0 <= ~range_min < ~range_max (m), have " +
-                                                 std::to_string(range_min_) + " and " +
-                                                 std::to_string(range_max_));
-  }
+  const auto node_config = readParameters(pnh, lms111::driverNodeConfigTable());
+  node_config.validate();
+  const lms111::DriverConfig& config = node_config.device;
+  frame_id_ = node_config.frame_id;
+  range_min_ = node_config.range_min_m;
+  range_max_ = node_config.range_max_m;
   scan_pub_ = nh.advertise<sensor_msgs::LaserScan>("scan", 10);
 
   expected_rate_ = config.scan_frequency_hz;

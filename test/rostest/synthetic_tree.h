@@ -22,10 +22,10 @@ inline sensor_msgs::PointCloud2 syntheticTree(const std::string& frame_id) {
   simulation::DatasetOptions o;
   o.seed = 3;
   o.sensor.range_noise_sigma = 0.006;
-  o.plan.heights = {1.5, 3.0};
+  o.plan.heights_m = {1.5, 3.0};
   o.plan.positions_per_height = 1;
   o.plan.slide_steps = 2;
-  o.plan.slide_step = 0.2;
+  o.plan.slide_step_m = 0.2;
   o.write_views = false;
   simulation::writeDataset(o, dir.string());
   const auto cloud = io::readCloud((dir / "target.pcd").string());

@@ -45,9 +45,9 @@ const registration::ViewFolder& dataset() {
     simulation::DatasetOptions o;
     o.seed = 5;
     o.sensor.range_noise_sigma = 0.006;
-    o.plan.heights = {1.5};
+    o.plan.heights_m = {1.5};
     o.plan.slide_steps = 2;
-    o.plan.slide_step = 0.2;
+    o.plan.slide_step_m = 0.2;
     simulation::writeDataset(o, dir.string());
     registration::ViewFolder f = registration::readViewFolder(dir.string());
     std::filesystem::remove_all(dir);

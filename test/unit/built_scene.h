@@ -45,7 +45,7 @@ inline BuiltTrunk buildTrunk(const Points& pts, std::size_t trunk_points) {
   b.region.resize(trunk_points);
   std::iota(b.region.begin(), b.region.end(), 0);
   b.config = modeling::stageConfig(b.config);
-  b.config.noise_sigma = 0.002;
+  b.config.noise.sigma_m = 0.002;
   b.trunk = modeling::modelTrunk(pts, b.region, {{0, 0, 0}, {0, 0, 1.5}}, 0.03, b.config);
   return b;
 }

@@ -142,7 +142,7 @@ TEST(BranchAxes, SkipPlanesTrunksAndMixedSides) {
   // The beam footprint widens the silhouette: beams half on the branch report its edge. Taken
   // off, the radius is the branch's (a wider patch holds the widened silhouette whole).
   AxisConfig beams;  // a calibrated growth: 2 mm + 8 mm per metre, 18 mm at 2 m
-  beams.patch = 0.1;
+  beams.patch_m = 0.1;
   beams.silhouette_growth_m = 0.002;
   beams.silhouette_growth_per_m = 0.008;
   HalfView wide = seeHalves({STICKS.front()}, {0, -2, 1.5}, 0, 1);
@@ -168,7 +168,7 @@ TEST(BranchAxes, RejectBadInput) {
   bad.silhouette_growth_per_m = 0.5;
   EXPECT_THROW(bad.validate(), Error);
   bad = AxisConfig{};
-  bad.max_radius = 0.001;
+  bad.max_radius_m = 0.001;
   EXPECT_THROW(bad.validate(), Error);
   EXPECT_THROW(estimateAxes(Points(20), Points(19), std::vector<double>(20), {}, AxisConfig{}),
                Error);
@@ -182,7 +182,7 @@ TEST(BranchAxes, PullABackStationBackAlongTheRays) {
   const HalfView f = seeHalves(STICKS, front, 0.004, 4), b = seeHalves(STICKS, back, 0.004, 5);
   IcpConfig icp;
   auto pyramid = [&](const HalfView& v) {
-    Pyramid p = makePyramid(v.points, v.view_dirs, icp.voxels, icp.normal_neighbors);
+    Pyramid p = makePyramid(v.points, v.view_dirs, icp.voxels_m, icp.normal_neighbors);
     p.axes = estimateAxes(v.points, v.view_dirs, v.ranges, p.levels[1].points, idealBeams());
     return p;
   };
@@ -191,7 +191,7 @@ TEST(BranchAxes, PullABackStationBackAlongTheRays) {
   ASSERT_GT(source.axes.size(), 20u);
   Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
   guess.translation() = Eigen::Vector3d(0.003, -0.009, 0.002);
-  const int finest = static_cast<int>(icp.voxels.size()) - 1;
+  const int finest = static_cast<int>(icp.voxels_m.size()) - 1;
   const IcpResult with_axes = alignPyramids(source, target, guess, icp, finest);
   icp.axis_pairs = false;
   const IcpResult ray_only = alignPyramids(source, target, guess, icp, finest);

@@ -53,7 +53,7 @@ TEST(BranchCutOff, ABranchWhoseReturnsBreakOffNearTheTrunkIsKept) {
   EXPECT_FALSE(kept[0].reaches_surface);
   EXPECT_EQ(countReason(rejected, BranchRejection::TOO_SHORT), 1);  // the piece at the trunk
 
-  config.branch_keep_cut_off = false;
+  config.branches.keep_cut_off = false;
   rejected.clear();
   EXPECT_TRUE(modelBranches(pts, index, trunk, region, config, &rejected).empty());
   EXPECT_GE(countReason(rejected, BranchRejection::NOT_AT_THE_SURFACE),

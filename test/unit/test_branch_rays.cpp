@@ -78,7 +78,7 @@ TEST(BranchModel, AFusedWhorlAtCentimetreNoiseIsPartedAlongItsRays) {
   for (const double az : azimuths)
     addRay(pts, rng, 1.0, direction(az, 15), 1500, 0.012);
   ModelerConfig config;
-  config.noise_sigma = 0.012;
+  config.noise.sigma_m = 0.012;
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2}}, 0.03, config);
   const PointIndex index(pts);
   const auto found = [&](const std::vector<BranchFit>& branches) {
@@ -92,7 +92,7 @@ TEST(BranchModel, AFusedWhorlAtCentimetreNoiseIsPartedAlongItsRays) {
   const auto parted = modelBranches(pts, index, trunk, region, config);
   EXPECT_EQ(found(parted), 3);
   EXPECT_EQ(parted.size(), 3u);
-  config.branch_ray_split = false;
+  config.branches.ray_split = false;
   EXPECT_LT(found(modelBranches(pts, index, trunk, region, config)), 3);
 }
 

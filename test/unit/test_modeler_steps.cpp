@@ -42,8 +42,8 @@ TEST(SplitMerge, ACleanCylinderStaysAndATeeIsSplit) {
   std::vector<Cluster> clusters{clusterOf(pts, 0, straight),
                                 clusterOf(pts, straight, static_cast<int>(pts.size()))};
   EXPECT_LT(clusters[0].error, 1e-4);
-  EXPECT_GT(clusters[1].error, config.split_error);
-  const auto split = splitClusters(pts, clusters, config.split_error, config);
+  EXPECT_GT(clusters[1].error, config.graph.split_error_m);
+  const auto split = splitClusters(pts, clusters, config.graph.split_error_m, config);
   int pieces_of_straight = 0, pieces_of_tee = 0;
   for (const auto& c : split)
     (c.members.front() < straight ? pieces_of_straight : pieces_of_tee)++;
@@ -121,7 +121,7 @@ TEST(ClusterGraph, TrunkPathClimbsAndBranchesAreAdjacent) {
 TEST(ClusterGraph, PsiTStopsAtNearHorizontalSteps) {
   const Fixture f;
   ModelerConfig config = ModelerConfig::paper();
-  config.psi_t = 1.0;  // only perfectly vertical steps
+  config.graph.psi_t_deg = 1.0;  // only perfectly vertical steps
   const auto adjacency = connectClusters(f.pts, PointIndex(f.pts), f.clusters, config);
   EXPECT_EQ(findTrunkPath(f.clusters, adjacency, config).trunk.size(),
             3u);  // the stack is exactly vertical
@@ -155,8 +155,8 @@ TEST(TrunkModel, TaperedTrunkWithBranchesGivesSegmentsAndRadii) {
   std::vector<int> region(pts.size());
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
-  config.noise_sigma = 0.0;
-  config.beam_spread = 0.0;
+  config.noise.sigma_m = 0.0;
+  config.noise.beam_spread_m = 0.0;
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.035, config);
   ASSERT_GE(trunk.cylinders.size(), 2u);
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
@@ -233,8 +233,8 @@ TEST(TrunkModel, TaperProfileMeasuresANoisyTrunkWithBranchStubs) {
   std::vector<int> region(pts.size());
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
-  config.noise_sigma = 0.0;  // no calibration: the fixture's noise is not the scanner's
-  config.beam_spread = 0.0;
+  config.noise.sigma_m = 0.0;  // no calibration: the fixture's noise is not the scanner's
+  config.noise.beam_spread_m = 0.0;
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, height}}, 0.04, config);
   ASSERT_GE(trunk.cylinders.size(), 2u);
   double weighted = 0.0, total = 0.0;
@@ -337,8 +337,8 @@ TEST(TrunkModel, ALeaderThatBendsIsSplitWhereItLeavesTheChord) {
   std::vector<int> region(pts.size());
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
-  config.noise_sigma = 0.0;
-  config.beam_spread = 0.0;
+  config.noise.sigma_m = 0.0;
+  config.noise.beam_spread_m = 0.0;
   // How far the true centreline gets from the axis of the cylinder covering its height.
   auto worstOffset = [&](const TrunkModel& trunk) {
     double worst = 0.0;
@@ -353,10 +353,10 @@ TEST(TrunkModel, ALeaderThatBendsIsSplitWhereItLeavesTheChord) {
     }
     return worst;
   };
-  config.trunk_max_segment_length = 0.0;  // the bend alone cuts this 1.6 m trunk
-  config.trunk_max_bend = 0.0;
+  config.trunk.max_segment_length_m = 0.0;  // the bend alone cuts this 1.6 m trunk
+  config.trunk.max_bend_m = 0.0;
   const TrunkModel straight = modelTrunk(pts, region, {centre(0), centre(1.6)}, 0.03, config);
-  config.trunk_max_bend = 0.01;
+  config.trunk.max_bend_m = 0.01;
   const TrunkModel bent = modelTrunk(pts, region, {centre(0), centre(1.6)}, 0.03, config);
   std::printf("[ INFO ] %zu cylinders %.1f mm off the centreline; split at bends: %zu, %.1f mm\n",
               straight.cylinders.size(), 1000 * worstOffset(straight), bent.cylinders.size(),
@@ -405,16 +405,16 @@ TEST(TrunkModel, ASegmentThickerThanTheOneBelowIsBoundedByIt) {
   std::vector<int> region(pts.size());
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
-  config.noise_sigma = 0.0;
-  config.beam_spread = 0.0;
-  config.radius_continuity = 1.0;  // let the slices follow the jump
+  config.noise.sigma_m = 0.0;
+  config.noise.beam_spread_m = 0.0;
+  config.trunk.radius_continuity = 1.0;  // let the slices follow the jump
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.04, config);
   ASSERT_GE(trunk.cylinders.size(), 2u);
   for (std::size_t i = 1; i < trunk.cylinders.size(); ++i) {
     EXPECT_LE(trunk.cylinders[i].radius, 1.1 * trunk.cylinders[i - 1].radius + 1e-12)
         << "segment " << i;
   }
-  config.ours_constrain_ransac = false;
+  config.fit.constrain = false;
   const TrunkModel free = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1.2}}, 0.04, config);
   EXPECT_GT(free.cylinders.back().radius, 0.045);
 }
@@ -486,7 +486,7 @@ TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
   std::vector<int> region(trunk_points);
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
-  config.noise_sigma = 0.002;
+  config.noise.sigma_m = 0.002;
   const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, config);
   const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config);
   ASSERT_EQ(branches.size(), 1u);
@@ -496,8 +496,8 @@ TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
   // either missed or measured off its axis.
   // (Without the rescue of cut-off fits: the forced fit's extraction leaves the scaffold's
   // outer part, and that part alone would be kept.)
-  config.branch_max_steep_angle = config.branch_max_radial_angle;
-  config.branch_keep_cut_off = false;
+  config.branches.max_steep_angle_deg = config.branches.max_radial_angle_deg;
+  config.branches.keep_cut_off = false;
   const auto bounded = modelBranches(pts, PointIndex(pts), trunk, region, config);
   for (const auto& b : bounded)
     EXPECT_LT(b.cylinder.axis.dot(steep), std::cos(10.0 * M_PI / 180.0));
@@ -518,7 +518,7 @@ TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   for (const auto& r : rejected)
     EXPECT_FALSE(r.budget_spent) << r.text();
 
-  config.branch_search_budget = 0;
+  config.branches.search_budget = 0;
   rejected.clear();
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config, &rejected).size(), 1u);
   int unsearched = 0;
@@ -548,7 +548,7 @@ TEST(BranchModel, ADetectionWithFewPointsForItsTreeIsDropped) {
   for (const auto& r : rejected)
     dropped += r.reason == BranchRejection::FEW_POINTS_FOR_THIS_TREE;
   EXPECT_EQ(dropped, 1);
-  config.branch_min_relative_points = 0.0;
+  config.branches.min_relative_points = 0.0;
   EXPECT_EQ(modelBranches(pts, index, trunk, region, config).size(), 5u);
 }
 
@@ -632,28 +632,29 @@ TEST(TrunkModel, TooLittleIsNoTrunk) {
 
 TEST(ModelerConfig, PaperDefaultsAndValidation) {
   const ModelerConfig c;
-  EXPECT_EQ(c.cluster_points, 3000);
-  EXPECT_DOUBLE_EQ(c.split_error, 0.004);
-  EXPECT_DOUBLE_EQ(c.merge_distance, 0.05);
-  EXPECT_DOUBLE_EQ(c.n_low, 0.3);
-  EXPECT_DOUBLE_EQ(c.n_high, 0.7);
-  EXPECT_DOUBLE_EQ(c.psi_t, 72.0);
+  EXPECT_EQ(c.graph.points_per_cluster, 3000);
+  EXPECT_DOUBLE_EQ(c.graph.split_error_m, 0.004);
+  EXPECT_DOUBLE_EQ(c.graph.merge_distance_m, 0.05);
+  EXPECT_DOUBLE_EQ(c.graph.n_low, 0.3);
+  EXPECT_DOUBLE_EQ(c.graph.n_high, 0.7);
+  EXPECT_DOUBLE_EQ(c.graph.psi_t_deg, 72.0);
   EXPECT_NO_THROW(c.validate());
   const ModelerConfig p = ModelerConfig::paper();
-  EXPECT_FALSE(p.ours_constrain_ransac || p.ours_follow_diameter || p.ours_correct_noise_bias ||
-               p.ours_branch_shell || p.ours_derive_parameters || p.ours_remove_clutter);
+  EXPECT_FALSE(p.fit.constrain || p.graph.follow_diameter || p.noise.correct_bias ||
+               p.branches.shell || p.noise.derive_parameters || p.preprocess.remove_clutter);
   ModelerConfig bad;
-  bad.n_high = 0.2;  // below n_low
+  bad.graph.n_high = 0.2;  // below n_low
   EXPECT_THROW(bad.validate(), Error);
 }
 
 TEST(ModelerConfig, LoadsYamlAndRejectsBadFiles) {
   test::TempDir dir;
-  const auto ok = dir.write("ok.yaml", "tree_modeler:\n  psi_t: 60\n  ours_branch_shell: false\n");
+  const auto ok = dir.write(
+      "ok.yaml", "tree_modeler:\n  graph:\n    psi_t_deg: 60\n  branches:\n    shell: false\n");
   const ModelerConfig c = loadModelerConfig(ok);
-  EXPECT_DOUBLE_EQ(c.psi_t, 60.0);
-  EXPECT_FALSE(c.ours_branch_shell);
-  EXPECT_DOUBLE_EQ(c.split_error, 0.004);  // untouched default
+  EXPECT_DOUBLE_EQ(c.graph.psi_t_deg, 60.0);
+  EXPECT_FALSE(c.branches.shell);
+  EXPECT_DOUBLE_EQ(c.graph.split_error_m, 0.004);  // untouched default
   auto code = [](const std::string& path) {
     try {
       loadModelerConfig(path);
@@ -662,18 +663,43 @@ TEST(ModelerConfig, LoadsYamlAndRejectsBadFiles) {
     }
     return ErrorCode::IO_FAILURE;  // not thrown: fails the comparisons below
   };
-  EXPECT_EQ(code(dir.write("unknown.yaml", "psi_tt: 60\n")), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(dir.write("type.yaml", "psi_t: steep\n")), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(dir.write("range.yaml", "psi_t: 120\n")), ErrorCode::INVALID_ARGUMENT);
-  EXPECT_EQ(code(dir.write("broken.yaml", "psi_t: [1,\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.write("unknown.yaml", "graph:\n  psi_tt_deg: 60\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.write("type.yaml", "graph:\n  psi_t_deg: steep\n")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(dir.write("range.yaml", "graph:\n  psi_t_deg: 120\n")),
+            ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(dir.write("broken.yaml", "graph: {psi_t_deg: [1,\n")), ErrorCode::PARSE_ERROR);
   EXPECT_EQ(code(dir.file("missing.yaml")), ErrorCode::FILE_NOT_FOUND);
+}
+
+TEST(ModelerConfig, ErrorsNameTheKeyTheRangeAndTheNewNameOfARenamedKey) {
+  test::TempDir dir;
+  auto message = [](const std::string& path) {
+    try {
+      loadModelerConfig(path);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(dir.write("old.yaml", "tree_modeler:\n  psi_t: 60\n"))
+                .find("tree modeler parameter 'psi_t' is now 'graph.psi_t_deg'"),
+            std::string::npos);
+  EXPECT_NE(message(dir.write("range.yaml", "trunk:\n  slice_height_m: 0.7\n"))
+                .find("tree modeler parameter trunk.slice_height_m = 0.7 is outside [0.01, 0.5]"),
+            std::string::npos);
+  EXPECT_NE(message(dir.write("type.yaml", "fit:\n  ransac_iterations: 2.5\n"))
+                .find("'fit.ransac_iterations' has the wrong type (expected an integer)"),
+            std::string::npos);
+  ModelerConfig cross;
+  cross.branches.max_steep_angle_deg = 50.0;  // below max_radial_angle_deg
+  EXPECT_THROW(cross.validate(), Error);
 }
 
 TEST(ModelerConfig, ShippedConfigLoads) {
   const ModelerConfig c =
       loadModelerConfig(std::string(DTM_TEST_DATA_DIR) + "/../../config/tree_modeler.yaml");
-  EXPECT_DOUBLE_EQ(c.psi_t, 72.0);
-  EXPECT_TRUE(c.ours_follow_diameter);
+  EXPECT_DOUBLE_EQ(c.graph.psi_t_deg, 72.0);
+  EXPECT_TRUE(c.graph.follow_diameter);
   EXPECT_FALSE(c.calibration.given());  // the sensor calibration is a file of its own
 }
 

@@ -141,7 +141,7 @@ TEST(Preprocess, AStrayPointFarFromTheTreeIsDroppedAndCountedNotFatal) {
   EXPECT_EQ(removeFarOutliers(kept), 2u);
   EXPECT_EQ(kept.size(), clean.size() + 1);
   ModelerConfig config;
-  config.ours_remove_clutter = false;
+  config.preprocess.remove_clutter = false;
   PreprocessStats stats;
   const Points out = preprocess(pts, config, &stats);  // would not fit a grid's keys with them
   EXPECT_EQ(stats.far_outliers, 2u);
@@ -156,19 +156,19 @@ TEST(Preprocess, AboveMaxModeledPointsACoarserGridKeepsTheCloudWithinIt) {
   for (int i = 0; i < 40000; ++i)
     wall.emplace_back(rng.uniform(0.0, 2.0), 0.001 * rng.normal(), rng.uniform(0.0, 2.0));
   ModelerConfig config;
-  config.ours_remove_clutter = false;
-  config.voxel_size = 0.002;
+  config.preprocess.remove_clutter = false;
+  config.preprocess.voxel_size_m = 0.002;
   PreprocessStats stats;
   EXPECT_EQ(preprocess(wall, config, &stats).size(), stats.after_voxel);
   EXPECT_EQ(stats.capped, 0u) << "within the cap: the configured grid only";
   EXPECT_DOUBLE_EQ(stats.voxel_size, 0.002);
-  config.max_modeled_points = 10000;
+  config.preprocess.max_points = 10000;
   const Points capped = preprocess(wall, config, &stats);
   EXPECT_LE(capped.size(), 10000u);
   EXPECT_GT(capped.size(), 5000u) << "one coarser grid, not a collapse";
   EXPECT_EQ(stats.capped, stats.after_voxel - capped.size());
   EXPECT_GT(stats.voxel_size, 0.002);
-  config.max_modeled_points = 10;
+  config.preprocess.max_points = 10;
   EXPECT_THROW(config.validate(), Error) << "a cap below any tree is refused";
 }
 
@@ -221,7 +221,7 @@ TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
                          [](const Eigen::Vector3d& p) { return std::hypot(p.x(), p.y()) < 0.07; });
   };
   EXPECT_LT(out.size() - onTrunk(out), 20u) << "what is left of the wire";
-  EXPECT_GT(onTrunk(out), 0.95 * onTrunk(voxelDownsample(pts, config.voxel_size)));
+  EXPECT_GT(onTrunk(out), 0.95 * onTrunk(voxelDownsample(pts, config.preprocess.voxel_size_m)));
 }
 
 }  // namespace

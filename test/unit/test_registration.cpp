@@ -248,9 +248,35 @@ TEST(Registration, RejectsBadInputWithClearErrors) {
   EXPECT_THROW(registerViews({v}, {}), Error);
   CoarseSearchConfig coarse;
   EXPECT_THROW(coarseSearch({}, Points(10, Eigen::Vector3d::Zero()), std::nullopt, coarse), Error);
-  coarse.cell = 0;
+  coarse.cell_m = 0;
   EXPECT_THROW(coarse.validate(), Error);
   EXPECT_THROW(loadRegistrationConfig("/nonexistent/registration.yaml"), Error);
+}
+
+TEST(Registration, LoadsNestedYamlAndNamesTheNestedKeyInErrors) {
+  test::TempDir dir;
+  const RegistrationConfig c = loadRegistrationConfig(
+      dir.write("r.yaml",
+                "registration:\n  icp:\n    voxels_m: [0.03, 0.015]\n  coarse:\n    "
+                "candidates: 5\n  use_hints: false\n"));
+  EXPECT_EQ(c.icp.voxels_m, (std::vector<double>{0.03, 0.015}));
+  EXPECT_EQ(c.coarse.candidates, 5);
+  EXPECT_FALSE(c.use_hints);
+  EXPECT_DOUBLE_EQ(c.axes.patch_m, 0.1);  // untouched default
+  auto message = [&dir](const std::string& text) {
+    try {
+      loadRegistrationConfig(dir.write("bad.yaml", text));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("icp:\n  trim: 1.5\n")
+                .find("registration parameter icp.trim = 1.5 is outside [0.01, 1]"),
+            std::string::npos);
+  EXPECT_NE(message("icp_trim: 0.5\n").find("'icp_trim' is now 'icp.trim'"), std::string::npos);
+  EXPECT_NE(message("candidate_levels: 4\n").find("at most the number of ICP levels"),
+            std::string::npos);
 }
 
 TEST(ViewFolder, WarnsOfANearlyEmptyViewAndRefusesMistypedKeys) {

@@ -11,7 +11,7 @@ namespace {
 
 std::vector<PlannedView> shortPlan() {
   ViewPlanConfig c;
-  c.heights = {1.5};
+  c.heights_m = {1.5};
   c.positions_per_height = 2;
   c.slide_steps = 3;
   c.back = false;

@@ -105,7 +105,7 @@ TEST(TreeModelTool, ExitCodesAreDistinctAndDocumented) {
   EXPECT_NE(out.find("no_trunk"), std::string::npos) << out;
   EXPECT_EQ(run("tree_model",
                 dir.file("plane.xyz") + " -o " + dir.file("m.json") + " -p " +
-                    dir.write("p.yaml", "psi_t: 500\n"),
+                    dir.write("p.yaml", "graph:\n  psi_t_deg: 500\n"),
                 &out),
             6)
       << out;
@@ -201,6 +201,20 @@ TEST(RenderModelTool, FarPointsAreSkippedAndAModelThatIsNoTreeIsRefused) {
   EXPECT_EQ(run("render_model", cloud_path + " " + far_model + " -o " + dir.file("b.png"), &out),
             3);
   EXPECT_NE(out.find("not a tree"), std::string::npos) << out;
+}
+
+TEST(ConfigReferenceTool, ShippedParameterFilesAndTheirDocAreTheCodesTables) {
+  std::string out;
+  EXPECT_EQ(run("config_reference", std::string("--check ") + DTM_CONFIG_DIR + "/..", &out), 0)
+      << out;
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("config"));
+  std::filesystem::create_directories(dir.file("docs"));
+  ASSERT_EQ(run("config_reference", "--write " + dir.file(""), &out), 0) << out;
+  std::ofstream(dir.file("config/view_plan.yaml"), std::ios::app) << "# edited by hand\n";
+  EXPECT_EQ(run("config_reference", "--check " + dir.file(""), &out), 1) << out;
+  EXPECT_NE(out.find("config/view_plan.yaml differs"), std::string::npos) << out;
+  EXPECT_EQ(out.find("tree_modeler.yaml"), std::string::npos) << out;
 }
 
 TEST(Lms111DecodeTool, DecodesTheRealTelegramAndRejectsOthers) {

@@ -162,7 +162,7 @@ std::string slurp(const std::string& path) {
 DatasetOptions smallDataset() {
   DatasetOptions o;
   o.seed = 21;
-  o.plan.heights = {1.5};
+  o.plan.heights_m = {1.5};
   o.plan.positions_per_height = 1;
   o.plan.slide_steps = 2;
   o.plan.back = false;

@@ -43,10 +43,10 @@ TEST(TreeModeler, BadInputsGiveDocumentedErrors) {
       ground.emplace_back(0.01 * i, 0.01 * k, 0.0);
   }
   ModelerConfig keep_ground;
-  keep_ground.ours_remove_clutter = false;
+  keep_ground.preprocess.remove_clutter = false;
   EXPECT_EQ(errorOf(TreeModeler(keep_ground), ground), ErrorCode::NO_TRUNK);
   ModelerConfig bad;
-  bad.psi_t = 0.0;
+  bad.graph.psi_t_deg = 0.0;
   EXPECT_THROW(TreeModeler{bad}, Error);
 }
 
@@ -77,10 +77,10 @@ Scan scanTree(const std::string& preset, std::uint64_t seed, double noise) {
   o.orchard.preset = preset;
   o.seed = seed;
   o.sensor.range_noise_sigma = noise;
-  o.plan.heights = {1.5, 3.0};
+  o.plan.heights_m = {1.5, 3.0};
   o.plan.positions_per_height = 1;
   o.plan.slide_steps = 2;
-  o.plan.slide_step = 0.2;
+  o.plan.slide_step_m = 0.2;
   o.write_views = false;
   simulation::writeDataset(o, dir.file("d"));
   Scan s;
@@ -172,7 +172,7 @@ TEST(TreeModeler, SaysWhatPreprocessingDroppedOrCoarsened) {
   EXPECT_TRUE(TreeModeler(ModelerConfig{}).model(pts).notices.empty());
   pts.emplace_back(1e7, 1e7, 1.0);
   ModelerConfig capped;
-  capped.max_modeled_points = 20000;
+  capped.preprocess.max_points = 20000;
   const ModelResult result = TreeModeler(capped).model(pts);
   ASSERT_EQ(result.notices.size(), 2u);
   EXPECT_EQ(result.notices[0], "dropped 1 stray points far outside the cloud's bulk");

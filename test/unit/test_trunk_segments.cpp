@@ -41,10 +41,10 @@ TrunkModel modelTapered(double max_segment_length) {
   std::iota(region.begin(), region.end(), 0);
   ModelerConfig config;
   // No beam, no noise: the sensor model's diameter calibration does not apply.
-  config.noise_sigma = 0.0;
-  config.beam_spread = 0.0;
+  config.noise.sigma_m = 0.0;
+  config.noise.beam_spread_m = 0.0;
   config.trunk_calibration = RadiusCalibration{};
-  config.trunk_max_segment_length = max_segment_length;
+  config.trunk.max_segment_length_m = max_segment_length;
   return modelTrunk(pts, region, {{0, 0, 0}, {0, 0, HEIGHT}}, 0.05, config);
 }
 
@@ -85,9 +85,9 @@ TEST(TrunkSegments, ALongTaperedTrunkIsCutIntoShortSegments) {
 
 TEST(TrunkSegments, ALengthBelowTwoShortestSegmentsIsRefused) {
   ModelerConfig config;
-  config.trunk_max_segment_length = 0.2;  // min_segment_length is 0.15
+  config.trunk.max_segment_length_m = 0.2;  // min_segment_length is 0.15
   EXPECT_THROW(config.validate(), Error);
-  config.trunk_max_segment_length = 0.0;
+  config.trunk.max_segment_length_m = 0.0;
   EXPECT_NO_THROW(config.validate());
 }
 

@@ -38,7 +38,7 @@ TEST(ViewPlan, ThePapersPlanHasFortyViews) {
 TEST(ViewPlan, YamlOverridesAndErrors) {
   test::TempDir dir;
   const auto plan =
-      loadViewPlan(dir.write("p.yaml", "heights: [1.2]\nslide_steps: 3\nback: false\n"));
+      loadViewPlan(dir.write("p.yaml", "heights_m: [1.2]\nslide_steps: 3\nback: false\n"));
   EXPECT_EQ(makeViewPlan(plan).size(), 6u);  // 1 height x 2 positions x 3 slide steps, front only
   auto code = [](const std::string& path) {
     try {
@@ -50,7 +50,7 @@ TEST(ViewPlan, YamlOverridesAndErrors) {
   };
   EXPECT_EQ(code(dir.write("u.yaml", "heigths: [1]\n")), ErrorCode::PARSE_ERROR);
   EXPECT_EQ(code(dir.write("t.yaml", "slide_steps: many\n")), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(dir.write("v.yaml", "standoff: 0.2\n")), ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(dir.write("v.yaml", "standoff_m: 0.2\n")), ErrorCode::INVALID_ARGUMENT);
   EXPECT_EQ(code(dir.file("none.yaml")), ErrorCode::FILE_NOT_FOUND);
 }
 

@@ -13,6 +13,10 @@
 #include "dormant_tree_modeling/lms111/scan_telegram.h"
 
 namespace dormant_tree_modeling {
+
+template <typename Config>
+class ConfigTable;
+
 namespace lms111 {
 
 /// @brief What the driver asks of the device and how patient it is. Angles in the device's
@@ -43,6 +47,22 @@ struct DriverConfig {
   /// @throws Error INVALID_ARGUMENT naming the bad field and its allowed values
   void validate() const;
 };
+
+/// @brief The driver node's parameters (config/lms111_driver.yaml): the device's, and how its
+/// scans are published.
+struct DriverNodeConfig {
+  DriverConfig device;
+  std::string frame_id = "laser";
+  double range_min_m = 0.5;   ///< datasheet; nearer returns are published as -Inf (REP 117)
+  double range_max_m = 20.0;  ///< datasheet (10 % reflectance); beyond: +Inf
+  /// @throws Error INVALID_ARGUMENT naming the bad parameter
+  void validate() const;
+};
+
+/// @brief The keys of DriverConfig: validation, the node's parameters, docs/configuration.md.
+const ConfigTable<DriverConfig>& driverConfigTable();
+/// @brief The keys of the driver node: the device's, frame_id and the published range.
+const ConfigTable<DriverNodeConfig>& driverNodeConfigTable();
 
 /// @brief Where the driver is in its life cycle.
 enum class DriverState { STOPPED, CONNECTING, CONFIGURING, STREAMING, BACKING_OFF };

@@ -73,10 +73,10 @@ bool curvedPieces(const BranchFit& a, const BranchFit& b);
 
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
-/// config.ours_branch_shell, every point of the cloud in a shell around the trunk cylinders.
+/// config.branches.shell, every point of the cloud in a shell around the trunk cylinders.
 /// Candidates are grouped by Euclidean clustering, one cluster per branch, and a RANSAC
 /// cylinder is fitted to each cluster's part within branch_fit_length of the trunk surface.
-/// With config.ours_constrain_ransac a branch must leave the trunk surface: its axis points
+/// With config.fit.constrain a branch must leave the trunk surface: its axis points
 /// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
 /// crossing near the trunk do not), and duplicates of one branch are merged.
 /// @param index a PointIndex of `pts`

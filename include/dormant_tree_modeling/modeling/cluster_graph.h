@@ -35,7 +35,7 @@ bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& confi
 void updateCluster(const Points& pts, Cluster& cluster);
 
 /// @brief Step 1: k-means into N_c = |pts| / cluster_points clusters (k-means++ seeding). With
-/// config.ours_derive_parameters the points per cluster follow the density instead:
+/// config.noise.derive_parameters the points per cluster follow the density instead:
 /// (0.15 m / spacing)^2, at most cluster_points.
 /// @param spacing median nearest-neighbour distance of pts (m), 0 when unknown
 std::vector<Cluster> initialClusters(const Points& pts, const ModelerConfig& config,
@@ -69,7 +69,7 @@ struct TrunkPath {
 
 /// @brief Step 5: from the start cluster follow, at each step, the edge with the smallest angle
 /// psi to the vertical while psi < psi_T (paper), starting at the lowest cluster. With
-/// config.ours_follow_diameter the choice also weighs how well the next cluster's radius
+/// config.graph.follow_diameter the choice also weighs how well the next cluster's radius
 /// continues the trunk's, and of the candidate bases near the bottom (sizeable, near-vertical
 /// cylinder pieces) the one whose walk gathers the most clusters wins: a post has no branches.
 

@@ -43,9 +43,9 @@ Points voxelDownsample(const Points& pts, double voxel);
 /// distances, as PointIndex measures them): floating pixels.
 std::vector<char> floatingMask(const Points& pts, double radius, int min_neighbors);
 
-/// @brief Downsample and, with config.ours_remove_clutter, drop floating pixels, the ground
+/// @brief Downsample and, with config.preprocess.remove_clutter, drop floating pixels, the ground
 /// plane and trellis wires (long straight thin near-horizontal runs); then, above
-/// config.max_modeled_points, downsample again on coarser grids.
+/// config.preprocess.max_points, downsample again on coarser grids.
 Points preprocess(const Points& pts, const ModelerConfig& config, PreprocessStats* stats);
 
 }  // namespace modeling

@@ -20,14 +20,14 @@ using modeling::Points;
 /// thing both sides see at the same place: each side estimates it from its own half (the
 /// silhouette gives the radius, the visible surface the depth).
 struct AxisConfig {
-  double patch = 0.1;         ///< diameter of the neighbourhood one axis sample is fitted on
+  double patch_m = 0.1;       ///< diameter of the neighbourhood one axis sample is fitted on
   int min_points = 15;        ///< fewer points in a patch: no sample
   double linearity = 2.0;     ///< largest / second PCA eigenvalue at least this (a stick)
   double max_view_cos = 0.5;  ///< |axis . view direction| at most this (seen from the side)
   /// Mean resultant length of the patch's view directions at least this: one side only.
   double min_view_agreement = 0.95;
-  double min_radius = 0.003;  ///< samples outside [min, max] radius are dropped (forks, trunk)
-  double max_radius = 0.04;
+  double min_radius_m = 0.003;  ///< samples outside [min, max] radius are dropped (forks, trunk)
+  double max_radius_m = 0.04;
   /// How much wider than its diameter a thin branch's one-sided silhouette looks: a beam
   /// partly on a branch still returns with the branch's range, so the visible width is
   /// 2 r + silhouette_growth_m + silhouette_growth_per_m x range. The scanner's own (its beam

@@ -13,15 +13,15 @@ namespace registration {
 /// platform moved: only its heading and position matter (the platform stands upright).
 /// Lengths in m, angles in degrees.
 struct CoarseSearchConfig {
-  double cell = 0.05;  ///< occupancy grid cell
+  double cell_m = 0.05;  ///< occupancy grid cell
   /// With a hint: headings within +-yaw_window of it, positions within +-xy_window, heights
   /// within +-z_window. Without one: the full turn, and xy/z windows around the centroids.
   double yaw_window_deg = 30.0;
   double yaw_step_deg = 2.0;
-  double xy_window = 1.0;
-  double z_window = 0.1;
-  double z_window_unhinted = 2.0;
-  double z_step = 0.05;
+  double xy_window_m = 1.0;
+  double z_window_m = 0.1;
+  double z_window_unhinted_m = 2.0;
+  double z_step_m = 0.05;
   int candidates = 3;  ///< best distinct poses returned
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;

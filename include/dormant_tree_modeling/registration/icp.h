@@ -12,11 +12,11 @@ namespace registration {
 struct IcpConfig {
   /// Voxel sizes of the levels, coarse to fine; each level's correspondence limit is
   /// distance_factor x its voxel (a wide basin first, a tight fit last).
-  std::vector<double> voxels = {0.04, 0.02, 0.01};
+  std::vector<double> voxels_m = {0.04, 0.02, 0.01};
   double distance_factor = 4.0;
   int max_iterations = 30;    ///< per level
   double trim = 0.8;          ///< share of the closest correspondences used
-  double huber = 0.01;        ///< m: residuals beyond count linearly (robust to clutter)
+  double huber_m = 0.01;      ///< m: residuals beyond count linearly (robust to clutter)
   int normal_neighbors = 12;  ///< k for the PCA normals
   /// Points whose view directions (towards their sensors) meet below this cosine were seen
   /// from opposite sides: they lie on opposite halves of a branch, a diameter apart along the
@@ -30,11 +30,11 @@ struct IcpConfig {
   double axis_max_angle_deg = 20.0;  ///< paired axes at most this far from parallel
   /// m: a source point counts towards the overlap when a target point lies this close (across
   /// the ray for pairs seen from opposite sides); ~2.5 sigma of the range noise.
-  double overlap_distance = 0.015;
+  double overlap_distance_m = 0.015;
   /// deg and m: converged below both steps (at the finest level; coarser levels scale them
   /// with their voxel size)
-  double min_rotation_step = 0.005;
-  double min_translation_step = 1e-4;
+  double min_rotation_step_deg = 0.005;
+  double min_translation_step_m = 1e-4;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };

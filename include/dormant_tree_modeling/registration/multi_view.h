@@ -11,6 +11,10 @@
 #include "dormant_tree_modeling/registration/icp.h"
 
 namespace dormant_tree_modeling {
+
+template <typename Config>
+class ConfigTable;
+
 namespace registration {
 
 /// @brief Settings of the multi-view registration (registration.yaml). Lengths in m.
@@ -26,14 +30,22 @@ struct RegistrationConfig {
   /// and the point-to-plane rmse stays below max_rmse: a view of another tree, or of nothing,
   /// does not pass.
   double min_overlap = 0.4;
-  double max_rmse = 0.012;
+  double max_rmse_m = 0.012;
   bool use_hints = true;  ///< false: ignore the guesses (global search from scratch)
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };
 
-/// @brief Load settings from YAML (flat keys: icp_*, coarse_*, and the fields above; the
-/// `registration:` section when present); missing keys keep defaults.
+/// @brief The keys of the registration settings (icp.*, axes.*, coarse.* and the fields above):
+/// YAML loading, validation and docs/configuration.md.
+const ConfigTable<RegistrationConfig>& registrationConfigTable();
+/// @brief The keys of each nested part, also used to validate it alone.
+const ConfigTable<IcpConfig>& icpConfigTable();
+const ConfigTable<AxisConfig>& axisConfigTable();
+const ConfigTable<CoarseSearchConfig>& coarseSearchConfigTable();
+
+/// @brief Load settings from YAML (the `registration:` map or the root, groups as nested maps);
+/// missing keys keep defaults, unknown keys are an error, renamed keys name their new name.
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR, INVALID_ARGUMENT
 RegistrationConfig loadRegistrationConfig(const std::string& path);
 

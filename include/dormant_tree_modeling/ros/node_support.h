@@ -3,8 +3,13 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <functional>
 #include <string>
+#include <vector>
+
+#include "dormant_tree_modeling/common/config_table.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -29,6 +34,35 @@ class NodeDiagnostics {
   diagnostic_updater::Updater updater_;
   ros::Timer timer_;
 };
+
+/// @brief A parameter server value as YAML, for ConfigTable::set.
+/// @throws Error PARSE_ERROR for a struct, a date or binary data
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
+
+/// @brief Stops with the new name when a renamed parameter is still set; warns once per
+/// private parameter that neither the table nor `others` knows (a misspelt parameter would
+/// otherwise be ignored without a word).
+void checkParameterNames(const ros::NodeHandle& pnh, const std::vector<FieldInfo>& fields,
+                         const std::vector<std::string>& others);
+
+/// @brief A node's parameters through the same table as its YAML file: each key (groups as
+/// `group/key`) read from the private namespace when set, else the default in `config`.
+/// @param others private parameters the node reads outside the table
+/// @throws Error PARSE_ERROR for a value of the wrong type or a renamed key; does not validate
+template <typename Config>
+Config readParameters(const ros::NodeHandle& pnh, const ConfigTable<Config>& table,
+                      Config config = Config{}, const std::vector<std::string>& others = {}) {
+  checkParameterNames(pnh, table.fields(), others);
+  for (const auto& field : table.fields()) {
+    std::string name = field.key;
+    for (auto& ch : name)
+      ch = ch == '.' ? '/' : ch;
+    XmlRpc::XmlRpcValue value;
+    if (pnh.getParam(name, value))
+      table.set(field.key, toYaml(value), config, "parameter " + pnh.resolveName(name));
+  }
+  return config;
+}
 
 /// @brief The main of a node class: ros::init, the node built from the public and the private
 /// node handle, its callbacks on `threads` threads until shutdown, then `on_shutdown(node)`
