@@ -96,7 +96,7 @@ void ensureDataset(const std::string& preset, std::uint64_t seed, const std::str
                    double noise_mm, const std::string& dir) {
   if (std::filesystem::exists(dir + "/target.pcd"))
     return;
-  simulation::DatasetOptions o;
+  simulation::DatasetConfig o;
   o.orchard.preset = preset;
   o.seed = seed;
   o.sensor = simulation::sensorVariant(world);

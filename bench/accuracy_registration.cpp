@@ -120,7 +120,7 @@ evaluation::TreeScore score(const Cloud& cloud, const evaluation::GroundTruth& t
 modeling::SensorCalibration rigCalibration(const std::string& world, const std::string& out) {
   const std::string dir = out + "/" + world + "_rig";
   if (!std::filesystem::exists(dir + "/views.json")) {
-    simulation::DatasetOptions o;
+    simulation::DatasetConfig o;
     o.orchard.preset = simulation::CALIBRATION_RIG_PRESET;
     o.sensor = simulation::sensorVariant(world);
     o.sensor.range_noise_sigma = NOISE_M;
@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < per_preset; ++k) {
         const std::string name = run.world + "_" + preset + "_" + std::to_string(k);
         const std::string dir = out + "/" + name;
-        simulation::DatasetOptions o;
+        simulation::DatasetConfig o;
         o.orchard.preset = preset;
         o.seed = 200 + k;
         o.sensor = simulation::sensorVariant(run.world);

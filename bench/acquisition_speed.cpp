@@ -30,7 +30,7 @@ double wallClock() {
 class Rig {
  public:
   explicit Rig(double frequency) {
-    simulation::VirtualPlatformOptions o;
+    simulation::VirtualPlatformConfig o;
     o.laser.cola_a_port = 0;
     o.laser.cola_b_port = -1;
     o.stage_port = 0;
@@ -114,7 +114,7 @@ void BM_View(benchmark::State& state) {
   const double frequency = static_cast<double>(state.range(0));
   const bool continuous = state.range(1) == 1;
   Rig rig(frequency);
-  acquisition::SweepSettings s;
+  acquisition::SweepConfig s;
   s.continuous = continuous;
   // The first sweep starts from where homing left the stage: put it at one end first.
   rig.io().move_rotary(s.theta_min - s.margin, 0.0);

@@ -20,7 +20,7 @@ const Cloud& merged() {
   static const CloudPtr cloud = [] {
     const std::string dir = (std::filesystem::temp_directory_path() / "dtm_speed_tree").string();
     if (!std::filesystem::exists(dir + "/merged.pcd")) {
-      simulation::DatasetOptions o;
+      simulation::DatasetConfig o;
       o.seed = 7;
       o.write_views = false;
       simulation::writeDataset(o, dir);

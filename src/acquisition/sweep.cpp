@@ -7,14 +7,14 @@
 namespace dormant_tree_modeling {
 namespace acquisition {
 
-void SweepSettings::validate() const {
+void SweepConfig::validate() const {
   if (!(theta_min < theta_max && theta_step > 0 && margin >= 0 && settle_s >= 0)) {
     throw Error(ErrorCode::INVALID_ARGUMENT,
                 "sweep: need theta_min < theta_max, theta_step > 0, margin >= 0, settle >= 0");
   }
 }
 
-RangeImage runSweep(const SweepIo& io, const SweepSettings& s, std::size_t* dropped,
+RangeImage runSweep(const SweepIo& io, const SweepConfig& s, std::size_t* dropped,
                     std::size_t* missing) {
   s.validate();
   constexpr double DEG = M_PI / 180.0;

@@ -472,7 +472,7 @@ double depthShare(const std::vector<StationPoints>& stations,
 }  // namespace
 
 RigScan readRigViews(const std::string& dir, const evaluation::GroundTruth& rig) {
-  registration::ViewFolderOptions o;
+  registration::ViewFolderConfig o;
   o.crop_radius = 0.0;
   o.use_guesses = false;
   o.ground_margin = -1.0;

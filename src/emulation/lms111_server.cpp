@@ -114,7 +114,7 @@ struct LmsServer::Impl {
     }
   };
 
-  Impl(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options)
+  Impl(std::shared_ptr<EmulatedLms111> device, LmsServerConfig options)
       : device(std::move(device)), options(std::move(options)), scan_timer(io), restart_timer(io) {}
 
   double now() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
@@ -246,7 +246,7 @@ struct LmsServer::Impl {
 
   asio::io_context io;
   std::shared_ptr<EmulatedLms111> device;
-  LmsServerOptions options;
+  LmsServerConfig options;
   std::unique_ptr<tcp::acceptor> acceptors[2];
   int bound[2] = {-1, -1};
   std::list<std::shared_ptr<Session>> sessions;
@@ -259,7 +259,7 @@ struct LmsServer::Impl {
   std::atomic<std::size_t> sent{0}, accepted{0};
 };
 
-LmsServer::LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options)
+LmsServer::LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerConfig options)
     : impl_(std::make_unique<Impl>(std::move(device), std::move(options))) {
   if (!impl_->device)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the emulator server needs a device");

@@ -77,7 +77,7 @@ constexpr double FLOAT32_MILLIMETRE_LIMIT_M = 8192.0;
 
 }  // namespace
 
-CloudReadResult readCloud(const std::string& path, const CloudReadOptions& options) {
+CloudReadResult readCloud(const std::string& path, const CloudReadConfig& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw Error(ErrorCode::FILE_NOT_FOUND, path + " is a directory, not a point cloud file");

@@ -18,7 +18,7 @@ namespace {
 
 constexpr double DEG = M_PI / 180.0;
 // Candidates lie this far beyond the ends of the trunk cylinders along the centreline, and
-// (in the shell) this far beyond branch_fit_length off the trunk surface.
+// (in the shell) this far beyond branches.fit_length_m off the trunk surface.
 constexpr double SHELL_AXIAL_MARGIN = 0.05;  // m
 constexpr double SHELL_OUTER_MARGIN = 0.05;  // m
 // A fit cut off from the trunk surface keeps at least this much of its way back off every
@@ -68,7 +68,7 @@ BranchBands branchBands(const TrunkModel& trunk, const ModelerConfig& config) {
 }
 
 /// The candidate points: in the paper's way the points of `region` off their trunk segment's
-/// cylinder; with ours_branch_shell every point in a shell around the trunk cylinders, which
+/// cylinder; with branches.shell every point in a shell around the trunk cylinders, which
 /// starts away from the trunk because near its surface the trunk's noise links every branch
 /// to every other. Located on all cores, kept in index order.
 BranchCandidates collectCandidates(const Points& pts, const TrunkModel& trunk,

@@ -28,11 +28,11 @@ constexpr int AXIS_CANDIDATES = 8;
 // A fit wider across the trunk than along it by this share of its length is judged by its
 // azimuth (sideways or not); a near-vertical fit is not.
 constexpr double MIN_ACROSS_SHARE = 0.3;
-// A candidate this many times branch_min_points and more may be split when it fits no branch;
-// a remainder this many times branch_min_points and more is searched again.
+// A candidate this many times branches.min_points and more may be split when it fits no branch;
+// a remainder this many times branches.min_points and more is searched again.
 constexpr int SPLIT_MIN_SIZE = 4;
 constexpr int REMAINDER_MIN_SIZE = 2;
-// A candidate of this many times branch_min_points whose fit is too short is split and retried.
+// A candidate of this many times branches.min_points whose fit is too short is split and retried.
 constexpr int SHORT_SPLIT = 12;
 constexpr int HALVES_ITERATIONS = 20;  // of the k-means that halves a fused candidate
 // A found line's points: within its radius, the noise band and this margin of its axis.
@@ -44,7 +44,7 @@ constexpr double RAY_AGREEMENT = 20.0 * DEG;
 // branch's radius with a margin) of the ray.
 constexpr double RAY_MIN_BAND = 0.01;     // m
 constexpr double RAY_TUBE_RADIUS = 0.01;  // m
-// A fit cut off from the trunk surface (branch_keep_cut_off) needs returns on its way back to
+// A fit cut off from the trunk surface (branches.keep_cut_off) needs returns on its way back to
 // the trunk: at each step this share of the returns around the fit's centre, at least
 // CUT_FILL_MIN_POINTS.
 constexpr double CUT_WALK_REACH = 1.0;  // m, beyond any fit's way back
@@ -255,8 +255,8 @@ BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) c
 /// The axis the fit starts from: the near part's own direction, pointing away from the trunk.
 /// A steep scaffold (central leaders) leaves the trunk more upwards than outwards; its part in
 /// the shell is a long, clearly directed cluster, and its own direction is kept up to
-/// branch_max_steep_angle from the radial. A short or round cluster's direction says little:
-/// the radial replaces it beyond branch_max_radial_angle. None when the near part sits on the
+/// branches.max_steep_angle_deg from the radial. A short or round cluster's direction says little:
+/// the radial replaces it beyond branches.max_radial_angle_deg. None when the near part sits on the
 /// trunk axis.
 std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& near,
                                                                const Cylinder& seg) const {
@@ -286,7 +286,7 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
                                           const Direction& guess, std::vector<int>* inliers) {
   const ModelerConfig& config = context_.config;
   const BranchBands& bands = context_.bands;
-  CylinderRansacOptions o;
+  CylinderRansacConfig o;
   o.threshold = bands.threshold;
   o.circle_iterations = config.fit.ransac_iterations / 2;
   o.axis_candidates = AXIS_CANDIDATES;
@@ -341,7 +341,7 @@ bool BranchSearch::reachesSurface(const NearPart& near) const {
   return near.nearest_gap <= SURFACE_CONTACT + context_.bands.inner_gap;
 }
 
-/// Primaries are at least branch_min_length long and start above the ground: a short fragment
+/// Primaries are at least branches.min_length_m long and start above the ground: a short fragment
 /// is a spur, a shoot or what an extraction left of a branch; near the ground it is mixed
 /// pixels between the trunk base and the soil. A short fit to a large candidate ran across it
 /// (two branches meeting, a branch and its shoot): the halves may each hold a branch.

@@ -81,7 +81,7 @@ std::optional<Circle> fitCircle(const Points2& pts) {
   return c;
 }
 
-std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions& o,
+std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacConfig& o,
                                    std::vector<int>* inliers) {
   const int n = static_cast<int>(pts.size());
   if (n < 3)

@@ -147,7 +147,7 @@ std::optional<Cylinder> fitCylinder(const Points& pts, const Eigen::Vector3d& ax
 }
 
 std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
-                                       const CylinderRansacOptions& o, std::vector<int>* inliers) {
+                                       const CylinderRansacConfig& o, std::vector<int>* inliers) {
   if (pts.size() < 6)
     return std::nullopt;
   Rng rng(o.seed);
@@ -165,7 +165,7 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
     axes.push_back((std::cos(tilt) * guess + std::sin(tilt) * (std::cos(az) * u + std::sin(az) * v))
                        .normalized());
   }
-  CircleRansacOptions co;
+  CircleRansacConfig co;
   co.threshold = o.threshold;
   co.iterations = o.circle_iterations;
   co.min_radius = o.min_radius;
@@ -183,7 +183,7 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
         plane.reserve(pts.size());
         for (const auto& p : pts)
           plane.emplace_back(p.dot(ku), p.dot(kv));
-        CircleRansacOptions ko = co;
+        CircleRansacConfig ko = co;
         ko.seed = o.seed * 1000003ULL + static_cast<std::uint64_t>(k);
         found[k] = ransacCircle(plane, ko, &in[k]).has_value();
       },

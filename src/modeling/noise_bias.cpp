@@ -35,7 +35,7 @@ constexpr int VIEWS = 8;
 constexpr int SLICE_RETURNS_PER_VIEW = 60;
 constexpr int ROD_RETURNS_PER_VIEW = 150;
 constexpr int REPEATS = 8;
-constexpr double ROD_LENGTH_M = 0.25;  // about branch_fit_length
+constexpr double ROD_LENGTH_M = 0.25;  // about branches.fit_length_m
 const double ROD_ELEVATIONS_RAD[] = {0.0, 20.0 * M_PI / 180.0, 40.0 * M_PI / 180.0};
 // The trunk step bounds a slice radius by the trunk's (SLICE_*_RADIUS_SHARE), the branch step a
 // branch's by the trunk radius where it leaves: primaries are 0.3..0.6 of it.
@@ -77,9 +77,9 @@ Points2 noisySlice(double r, double sigma, Rng& rng) {
 }
 
 /// The trunk step's circle options for a section of radius r under noise sigma.
-CircleRansacOptions sliceOptions(const ModelerConfig& config, double r, double sigma,
-                                 std::uint64_t seed) {
-  CircleRansacOptions o;
+CircleRansacConfig sliceOptions(const ModelerConfig& config, double r, double sigma,
+                                std::uint64_t seed) {
+  CircleRansacConfig o;
   o.threshold = config.noise.derive_parameters
                     ? std::max(config.fit.circle_threshold_m, noiseBand(sigma))
                     : config.fit.circle_threshold_m;
@@ -96,7 +96,7 @@ double sliceBias(const ModelerConfig& config, double r, double sigma, std::uint6
   for (int rep = 0; rep < REPEATS; ++rep) {
     Rng rng = Rng::derive(seed, rep);
     const Points2 plane = noisySlice(r, sigma, rng);
-    const CircleRansacOptions o = sliceOptions(config, r, sigma, rng.next());
+    const CircleRansacConfig o = sliceOptions(config, r, sigma, rng.next());
     const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
     if (c && c->surface) {
       sum += c->circle.radius - r;
@@ -144,7 +144,7 @@ double estimatedNoise(const ModelerConfig& config, double sigma, std::uint64_t s
   for (int rep = 0; rep < REPEATS; ++rep) {
     Rng rng = Rng::derive(seed, rep);
     const Points2 plane = noisySlice(ESTIMATOR_RADIUS_M, sigma, rng);
-    const CircleRansacOptions o = sliceOptions(config, ESTIMATOR_RADIUS_M, sigma, rng.next());
+    const CircleRansacConfig o = sliceOptions(config, ESTIMATOR_RADIUS_M, sigma, rng.next());
     const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
     if (!c)
       continue;

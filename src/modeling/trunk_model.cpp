@@ -43,7 +43,7 @@ struct SliceBounds {
 
 }  // namespace
 
-std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const CircleRansacOptions& o,
+std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const CircleRansacConfig& o,
                                               bool surface, double min_radius, double max_radius) {
   std::vector<int> inliers;
   auto circle = ransacCircle(plane, o, &inliers);
@@ -122,7 +122,7 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     Points2 plane;
     for (const int i : members[n])
       plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
-    CircleRansacOptions o;
+    CircleRansacConfig o;
     o.threshold = threshold;
     o.iterations = config.fit.ransac_iterations;
     o.min_radius = bounds.min_radius;
@@ -257,7 +257,7 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
   Eigen::Vector3d axis = (line.pointAt(b) - line.pointAt(a)).normalized();
   if (!axis.allFinite())
     axis = Eigen::Vector3d::UnitZ();
-  CylinderRansacOptions o;
+  CylinderRansacConfig o;
   o.threshold = threshold;
   o.circle_iterations = config.fit.ransac_iterations;
   o.seed = config.seed * 104729 + stream;
@@ -399,7 +399,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
       if (std::abs(w.dot(t)) <= 0.5 * h)
         plane.emplace_back(w.dot(u), w.dot(v));
     }
-    CircleRansacOptions o;
+    CircleRansacConfig o;
     o.threshold = threshold;
     o.iterations = config.fit.ransac_iterations;
     o.min_radius = first ? MIN_TRUNK_RADIUS : std::max(MIN_TRUNK_RADIUS, 0.6 * r);
@@ -668,7 +668,7 @@ double trunkNoise(const Points& pts, const std::vector<int>& region, const Cente
 }
 
 /// The segment boundaries along the centreline: disturbance partitions, short ones joined,
-/// split at curvature, at bends (trunk_max_bend) and where too long.
+/// split at curvature, at bends (trunk.max_bend_m) and where too long.
 std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
                               const std::vector<double>& s, const std::vector<double>& dist,
                               const SliceBounds& bounds, const Centerline& line,
@@ -699,7 +699,7 @@ std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
   return cuts;
 }
 
-/// One cylinder per segment; with ours_follow_diameter a segment no RANSAC cylinder fits (a
+/// One cylinder per segment; with graph.follow_diameter a segment no RANSAC cylinder fits (a
 /// whorl of branches, a bend) takes the centreline's chord and the slices' median radius,
 /// rather than leaving a gap in the trunk that would orphan the branches on it.
 void fitCylinders(const Points& pts, const std::vector<int>& region, const std::vector<double>& s,

@@ -42,7 +42,7 @@ std::optional<double> lowestDenseLevel(const Points& pts) {
 
 }  // namespace
 
-ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& options) {
+ViewFolder readViewFolder(const std::string& dir, const ViewFolderConfig& options) {
   const std::string index_path = dir + "/views.json";
   if (!std::filesystem::exists(index_path))
     throw Error(ErrorCode::FILE_NOT_FOUND, index_path + " does not exist (not a folder of views)");
@@ -72,7 +72,7 @@ ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& optio
       }
       const bool guided = guess && options.use_guesses;
       const std::string cloud_path = dir + "/views/" + in.name + ".pcd";
-      io::CloudReadOptions ro;
+      io::CloudReadConfig ro;
       ro.allow_empty = true;
       ro.recenter_threshold = INFINITY;
       const auto cloud = io::readCloud(cloud_path, ro).cloud;

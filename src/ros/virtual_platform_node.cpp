@@ -41,7 +41,7 @@ std::string describe(const Eigen::Isometry3d& pose) {
 }  // namespace
 
 VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  simulation::VirtualPlatformOptions o;
+  simulation::VirtualPlatformConfig o;
   o.laser.cola_a_port = portParam(pnh, "lms_port", 2111);
   o.laser.cola_b_port = portParam(pnh, "lms_b_port", 2112);
   o.stage_port = portParam(pnh, "aerotech_port", 8000);

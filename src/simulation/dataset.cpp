@@ -58,7 +58,7 @@ Eigen::Isometry3d randomPlatformError(Rng& rng, double max_translation, double m
 
 // One pass over the view plan writing each view's files as it is simulated, so a dataset of
 // 40 views never holds more than one view in memory.
-DatasetSummary writeDataset(const DatasetOptions& options, const std::string& dir) {
+DatasetSummary writeDataset(const DatasetConfig& options, const std::string& dir) {
   const auto start = std::chrono::steady_clock::now();
   const Orchard orchard = generateOrchard(options.orchard, options.seed);
   const auto plan = acquisition::makeViewPlan(options.plan);

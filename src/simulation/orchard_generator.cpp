@@ -23,7 +23,7 @@ Orchard generateOrchard(const OrchardConfig& config, std::uint64_t seed) {
     rig.scene.has_ground = config.ground;
     return rig;
   }
-  const TreeParams params = presetParams(config.preset);
+  const TreeConfig params = presetParams(config.preset);
   Rng rng = Rng::derive(seed, 1);
   Orchard orchard;
   Scene& scene = orchard.scene;

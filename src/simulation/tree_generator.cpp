@@ -79,7 +79,7 @@ Eigen::Vector3d tangentAt(const std::vector<Eigen::Vector3d>& pts, std::size_t i
   return (pts[b] - pts[a]).normalized();
 }
 
-BranchPolyline makeTrunk(const TreeParams& p, const Eigen::Vector3d& base, double height,
+BranchPolyline makeTrunk(const TreeConfig& p, const Eigen::Vector3d& base, double height,
                          Rng& rng) {
   const double lean = rng.uniform(0.0, p.lean_max_deg) * DEG;
   const double lean_azimuth = rng.uniform(0.0, 2.0 * M_PI);
@@ -107,7 +107,7 @@ BranchPolyline makeTrunk(const TreeParams& p, const Eigen::Vector3d& base, doubl
   return trunk;
 }
 
-void addShoots(TreeObject& tree, int parent, const TreeParams& p, Rng& rng) {
+void addShoots(TreeObject& tree, int parent, const TreeConfig& p, Rng& rng) {
   const BranchPolyline primary = tree.branches[parent];  // copy: branches grows below
   const double length = polylineLength(primary.points);
   const double trunk_clearance = 0.06;
@@ -151,7 +151,7 @@ void addShoots(TreeObject& tree, int parent, const TreeParams& p, Rng& rng) {
 
 }  // namespace
 
-TreeObject generateTree(const TreeParams& p, std::uint64_t seed, const Eigen::Vector3d& base,
+TreeObject generateTree(const TreeConfig& p, std::uint64_t seed, const Eigen::Vector3d& base,
                         double azimuth_offset) {
   Rng rng(seed);
   TreeObject tree;

@@ -20,8 +20,8 @@ std::vector<std::string> variantPresetNames() {
 namespace {
 
 /// Trees the modeler is only scored on: the young tall spindle with one trait pushed.
-std::optional<TreeParams> variantParams(const std::string& name) {
-  TreeParams p;
+std::optional<TreeConfig> variantParams(const std::string& name) {
+  TreeConfig p;
   p.preset = name;
   if (name == "crooked_leader") {
     p.bend_amplitude_max = 0.15;  // the leader sways up to 15 cm off its line
@@ -57,8 +57,8 @@ std::optional<TreeParams> variantParams(const std::string& name) {
 
 }  // namespace
 
-TreeParams presetParams(const std::string& name) {
-  TreeParams p;
+TreeConfig presetParams(const std::string& name) {
+  TreeConfig p;
   p.preset = name;
   if (name == "young_tall_spindle") {
     return p;  // the struct defaults describe it

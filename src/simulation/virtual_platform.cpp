@@ -6,7 +6,7 @@
 namespace dormant_tree_modeling {
 namespace simulation {
 
-VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformOptions& o) {
+VirtualPlatform::VirtualPlatform(const Scene& scene, const VirtualPlatformConfig& o) {
   if (o.scan_frequency_hz != 25.0 && o.scan_frequency_hz != 50.0)
     throw Error(ErrorCode::INVALID_ARGUMENT, "the LMS111 runs at 25 or 50 Hz");
   ensemble_ =

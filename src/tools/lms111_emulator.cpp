@@ -17,7 +17,7 @@ using namespace dormant_tree_modeling;
 // Long by design: the options (scene, pose, noise, faults, session) in the order --help lists
 // them, then the server.
 int main(int argc, char** argv) {
-  emulation::LmsServerOptions server;
+  emulation::LmsServerConfig server;
   emulation::LmsEmulatorConfig device;
   emulation::LmsFaults faults;
   std::string telegram, session, scene_path, preset = "young_tall_spindle";

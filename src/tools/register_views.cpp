@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     }
     if (vm.count("no-hints"))
       config.use_hints = false;
-    registration::ViewFolderOptions fo;
+    registration::ViewFolderConfig fo;
     if (vm.count("no-crop")) {
       fo.crop_radius = 0;
       fo.ground_margin = -1;

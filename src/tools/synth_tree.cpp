@@ -10,7 +10,7 @@ namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
 
 int main(int argc, char** argv) {
-  simulation::DatasetOptions opt;
+  simulation::DatasetConfig opt;
   std::string out, views;
   double noise_mm = 12.0, resolution = 0.25;
   std::string sensor = "ours";

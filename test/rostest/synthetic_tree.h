@@ -19,7 +19,7 @@ namespace test {
 inline sensor_msgs::PointCloud2 syntheticTree(const std::string& frame_id) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("dtm_rostest_" + std::to_string(getpid()));
-  simulation::DatasetOptions o;
+  simulation::DatasetConfig o;
   o.seed = 3;
   o.sensor.range_noise_sigma = 0.006;
   o.plan.heights_m = {1.5, 3.0};

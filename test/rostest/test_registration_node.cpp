@@ -42,7 +42,7 @@ const registration::ViewFolder& dataset() {
   static const registration::ViewFolder folder = [] {
     const auto dir = std::filesystem::temp_directory_path() /
                      ("dtm_registration_rostest_" + std::to_string(getpid()));
-    simulation::DatasetOptions o;
+    simulation::DatasetConfig o;
     o.seed = 5;
     o.sensor.range_noise_sigma = 0.006;
     o.plan.heights_m = {1.5};

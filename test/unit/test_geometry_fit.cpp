@@ -54,7 +54,7 @@ TEST(Circle, RansacIgnoresOutliersAndRespectsBounds) {
   }
   for (int i = 0; i < 100; ++i)
     pts.emplace_back(rng.uniform(0.1, 0.4), rng.uniform(-0.2, 0.2));  // a branch
-  CircleRansacOptions o;
+  CircleRansacConfig o;
   o.threshold = 0.004;
   std::vector<int> inliers;
   const auto c = ransacCircle(pts, o, &inliers);
@@ -98,7 +98,7 @@ TEST(Cylinder, RansacWithOutliersAndAxisBounds) {
   const Points branch =
       cylinderPoints({0, 0, 0.2}, Eigen::Vector3d(1, 0, 0.2), 0.01, 0.3, 200, 0.001, 5);
   pts.insert(pts.end(), branch.begin(), branch.end());
-  CylinderRansacOptions o;
+  CylinderRansacConfig o;
   o.threshold = 0.004;
   o.max_axis_deviation = 0.3;
   std::vector<int> inliers;

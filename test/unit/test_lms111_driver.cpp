@@ -66,7 +66,7 @@ struct Bench {
     c.spin_up_seconds = 0.05;
     c.scan.frequency = c.scan.resolution = frequency_hz == 50.0 ? 5000 : 2500;
     device = std::make_shared<EmulatedLms111>(c, recorded(), faults);
-    LmsServerOptions o;
+    LmsServerConfig o;
     o.cola_a_port = 0;
     o.cola_b_port = 0;
     server = std::make_unique<LmsServer>(device, o);

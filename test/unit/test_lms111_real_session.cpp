@@ -191,7 +191,7 @@ struct Sink {
 };
 
 DriverStatistics streamFrom(std::shared_ptr<EmulatedLms111> device, Protocol protocol, Sink& sink) {
-  LmsServerOptions options;
+  LmsServerConfig options;
   options.cola_a_port = options.cola_b_port = 0;
   LmsServer server(device, options);
   DriverConfig config;

@@ -139,7 +139,7 @@ TEST(ReadCloud, AllNonFiniteIsEmptyInput) {
   test::TempDir dir;
   const auto path = dir.write("t.xyz", "nan nan nan\n");
   EXPECT_EQ(errorOf([&] { readCloud(path); }), ErrorCode::EMPTY_INPUT);
-  io::CloudReadOptions options;
+  io::CloudReadConfig options;
   options.allow_empty = true;
   EXPECT_EQ(readCloud(path, options).cloud->size(), 0u);
 }

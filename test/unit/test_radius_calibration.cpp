@@ -81,7 +81,7 @@ TEST(SurfaceCircle, IgnoresABranchBaseThatPullsLeastSquaresOutwards) {
   const auto ls = fitCircle(pts);
   ASSERT_TRUE(ls);
   EXPECT_GT(ls->radius, 0.034);  // the plain fit is pulled out
-  CircleRansacOptions o;
+  CircleRansacConfig o;
   o.threshold = 0.0075;
   o.min_radius = 0.01;
   o.max_radius = 0.08;

@@ -146,7 +146,7 @@ class RigCalibration : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new test::TempDir;
-    simulation::DatasetOptions o;
+    simulation::DatasetConfig o;
     o.orchard.preset = simulation::CALIBRATION_RIG_PRESET;
     o.sensor.range_noise_sigma = 0.006;
     simulation::writeDataset(o, dir_->file("rig"));
@@ -277,7 +277,7 @@ TEST_F(RigCalibration, BadRigFilesAndScansGiveErrorsOrWarningsNeverASilentTable)
 TEST_F(RigCalibration, ATreeOfTheSameWorldMeasuresWithinBoundsAndSaysWhichCalibration) {
   auto result = calibration::calibrateFromRig({*scan_}, modeling::ModelerConfig{}, "sim");
   result.calibration.hash = "0123456789abcdef";
-  simulation::DatasetOptions o;
+  simulation::DatasetConfig o;
   o.seed = 41;  // not a bench tree
   o.sensor.range_noise_sigma = 0.006;
   o.write_views = false;

@@ -34,7 +34,7 @@ TEST(Presets, UnknownNameListsTheKnownOnes) {
 }
 
 TEST(TreeGenerator, YoungTallSpindleStaysInItsRanges) {
-  const TreeParams p = presetParams("young_tall_spindle");
+  const TreeConfig p = presetParams("young_tall_spindle");
   int large_ratio = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     const TreeObject tree = generateTree(p, seed, Eigen::Vector3d::Zero());
@@ -77,7 +77,7 @@ TEST(TreeGenerator, YoungTallSpindleStaysInItsRanges) {
 }
 
 TEST(TreeGenerator, CentralLeaderHasFewThickScaffolds) {
-  const TreeParams p = presetParams("central_leader");
+  const TreeConfig p = presetParams("central_leader");
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     const auto truth = truthFromTree(generateTree(p, seed, Eigen::Vector3d::Zero()));
     EXPECT_GE(truth.trunk.diameters.front(), 0.10);
@@ -159,8 +159,8 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-DatasetOptions smallDataset() {
-  DatasetOptions o;
+DatasetConfig smallDataset() {
+  DatasetConfig o;
   o.seed = 21;
   o.plan.heights_m = {1.5};
   o.plan.positions_per_height = 1;
@@ -172,9 +172,9 @@ DatasetOptions smallDataset() {
 
 TEST(Dataset, SameSeedGivesByteIdenticalFilesOnAnyThreadCount) {
   test::TempDir dir;
-  DatasetOptions a = smallDataset();
+  DatasetConfig a = smallDataset();
   a.threads = 1;
-  DatasetOptions b = smallDataset();
+  DatasetConfig b = smallDataset();
   b.threads = 2;
   const auto sa = writeDataset(a, dir.file("a"));
   writeDataset(b, dir.file("b"));
@@ -187,7 +187,7 @@ TEST(Dataset, SameSeedGivesByteIdenticalFilesOnAnyThreadCount) {
     EXPECT_FALSE(fa.empty()) << f;
     EXPECT_EQ(fa, slurp(dir.file(std::string("b/") + f))) << f;
   }
-  DatasetOptions c = smallDataset();
+  DatasetConfig c = smallDataset();
   c.seed = 22;
   writeDataset(c, dir.file("c"));
   EXPECT_NE(slurp(dir.file("a/merged.pcd")), slurp(dir.file("c/merged.pcd")));
@@ -198,7 +198,7 @@ TEST(Dataset, SameSeedGivesByteIdenticalFilesOnAnyThreadCount) {
 
 TEST(Dataset, GuessPosesArePerturbedWithinTheConfiguredBounds) {
   test::TempDir dir;
-  DatasetOptions o = smallDataset();
+  DatasetConfig o = smallDataset();
   o.write_views = false;
   writeDataset(o, dir.file("d"));
   const auto doc = nlohmann::json::parse(slurp(dir.file("d/views.json")));

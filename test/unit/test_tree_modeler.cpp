@@ -73,7 +73,7 @@ struct Scan {
 
 Scan scanTree(const std::string& preset, std::uint64_t seed, double noise) {
   test::TempDir dir;
-  simulation::DatasetOptions o;
+  simulation::DatasetConfig o;
   o.orchard.preset = preset;
   o.seed = seed;
   o.sensor.range_noise_sigma = noise;
@@ -144,7 +144,7 @@ TEST(TreeModeler, ChoosesTheCentredTrunkWhenSomeOfItsTracksStopLow) {
   // choice once took the neighbour 0.5 m away: four of the target's seven tracks stopped below
   // 1 m, and their small shells pulled its median score under the neighbour's.
   test::TempDir dir;
-  simulation::DatasetOptions o;
+  simulation::DatasetConfig o;
   o.orchard.preset = "central_leader";
   o.seed = 106;
   o.sensor.range_noise_sigma = 0.012;

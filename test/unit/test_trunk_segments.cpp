@@ -1,4 +1,4 @@
-// Trunk segments no longer than trunk_max_segment_length: a trunk tapers along metres without
+// Trunk segments no longer than trunk.max_segment_length_m: a trunk tapers along metres without
 // a disturbance to cut at.
 #include <gtest/gtest.h>
 

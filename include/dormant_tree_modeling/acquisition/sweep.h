@@ -11,7 +11,7 @@ namespace dormant_tree_modeling {
 namespace acquisition {
 
 /// @brief How a view's rotary sweep is run (angles in degrees).
-struct SweepSettings {
+struct SweepConfig {
   bool continuous = true;  ///< false: step-and-scan (the paper's)
   double theta_min = -45.0, theta_max = 45.0, theta_step = 0.45;
   double margin = 0.5;     ///< past each end, for the stage to reach speed (continuous)
@@ -42,7 +42,7 @@ struct SweepIo {
 /// @param dropped lines without stage coverage
 /// @param missing rows of the plan's θ grid that no line filled (lost scans)
 /// @throws Error IO_FAILURE from the stage or the laser, EMPTY_INPUT for a sweep without lines
-RangeImage runSweep(const SweepIo& io, const SweepSettings& settings, std::size_t* dropped,
+RangeImage runSweep(const SweepIo& io, const SweepConfig& settings, std::size_t* dropped,
                     std::size_t* missing = nullptr);
 
 }  // namespace acquisition

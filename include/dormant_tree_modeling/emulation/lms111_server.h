@@ -12,7 +12,7 @@ namespace emulation {
 
 /// @brief Where the emulator listens. A port of 0 picks a free one (see the accessors), -1
 /// disables that protocol.
-struct LmsServerOptions {
+struct LmsServerConfig {
   std::string address = "127.0.0.1";
   int cola_a_port = 2111;
   int cola_b_port = 2112;
@@ -24,7 +24,7 @@ struct LmsServerOptions {
 class LmsServer {
  public:
   /// @throws Error IO_FAILURE when a port cannot be bound
-  LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerOptions options = {});
+  LmsServer(std::shared_ptr<EmulatedLms111> device, LmsServerConfig options = {});
   ~LmsServer();
   LmsServer(const LmsServer&) = delete;
   LmsServer& operator=(const LmsServer&) = delete;

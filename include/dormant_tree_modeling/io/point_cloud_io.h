@@ -23,7 +23,7 @@ enum class CloudFormat {
 CloudFormat cloudFormatFromPath(const std::string& path);
 
 /// @brief Options of readCloud().
-struct CloudReadOptions {
+struct CloudReadConfig {
   /// Recentre coordinates when any |coordinate| exceeds this (m). Clouds in survey coordinates
   /// (e.g. UTM, 10^5..10^6 m) lose centimetres in float; they are shifted by a double-precision
   /// offset first. Set to infinity to never recentre.
@@ -46,7 +46,7 @@ struct CloudReadResult {
 /// @param options recentring and empty-cloud policy
 /// @throws Error FILE_NOT_FOUND, UNKNOWN_FORMAT, PARSE_ERROR (with line number for text),
 ///         EMPTY_INPUT (no finite point, unless options.allow_empty)
-CloudReadResult readCloud(const std::string& path, const CloudReadOptions& options = {});
+CloudReadResult readCloud(const std::string& path, const CloudReadConfig& options = {});
 
 /// @brief readCloud's points in double precision in the file's own frame (the offset put
 /// back), for comparing with positions given in that frame (survey coordinates included).

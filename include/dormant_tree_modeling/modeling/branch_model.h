@@ -25,19 +25,19 @@ struct BranchFit {
 
 /// @brief Why a branch candidate was turned down.
 enum class BranchRejection {
-  TOO_FEW_POINTS,            ///< fewer than branch_min_points within branch_fit_length
+  TOO_FEW_POINTS,            ///< fewer than branches.min_points within branches.fit_length_m
   NO_FIT,                    ///< no cylinder fits its near part
   OFF_ITS_RAY,               ///< parted along a ray, its fit leaves that ray
   NOT_RADIAL,                ///< the fit does not point away from the trunk
-  POINTS_DOWN,               ///< the fit dives below branch_min_elevation
-  THICKER_THAN_THE_TRUNK,    ///< wider than branch_max_diameter_ratio of its trunk segment
-  MISSES_THE_TRUNK,          ///< the fit's axis passes the trunk axis beyond branch_axis_gap
+  POINTS_DOWN,               ///< the fit dives below branches.min_elevation_deg
+  THICKER_THAN_THE_TRUNK,    ///< wider than branches.max_diameter_ratio of its trunk segment
+  MISSES_THE_TRUNK,          ///< the fit's axis passes the trunk axis beyond branches.axis_gap_m
   NOT_AT_THE_SURFACE,        ///< its points start away from the trunk with air between
-  TOO_SHORT,                 ///< shorter than branch_min_length
-  TOO_LOW,                   ///< attached below branch_min_height
+  TOO_SHORT,                 ///< shorter than branches.min_length_m
+  TOO_LOW,                   ///< attached below branches.min_height_m
   WIRE,                      ///< a trellis wire's points (taken out of the candidate)
   DUPLICATE,                 ///< a second detection of a branch already kept
-  FEW_POINTS_FOR_THIS_TREE,  ///< under branch_min_relative_points of the tree's median
+  FEW_POINTS_FOR_THIS_TREE,  ///< under branches.min_relative_points of the tree's median
   REMAINDER_NOT_SEARCHED,    ///< what an extraction left, with the search budget spent
 };
 
@@ -75,7 +75,7 @@ bool curvedPieces(const BranchFit& a, const BranchFit& b);
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
 /// config.branches.shell, every point of the cloud in a shell around the trunk cylinders.
 /// Candidates are grouped by Euclidean clustering, one cluster per branch, and a RANSAC
-/// cylinder is fitted to each cluster's part within branch_fit_length of the trunk surface.
+/// cylinder is fitted to each cluster's part within branches.fit_length_m of the trunk surface.
 /// With config.fit.constrain a branch must leave the trunk surface: its axis points
 /// away from the trunk and passes close to the trunk axis (neighbours' branches and wires
 /// crossing near the trunk do not), and duplicates of one branch are merged.

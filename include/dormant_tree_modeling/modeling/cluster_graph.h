@@ -28,7 +28,7 @@ struct Cluster {
 
 /// @brief Whether a cluster may be a trunk's foot: its centroid at most TRUNK_BASE_BAND_M above
 /// `zmin` (the lowest cluster's), at least 2 x min_cluster_points, and a cylinder fit within
-/// trunk_max_tilt of vertical. Algorithm 2's start candidates and the trunk tracking's bases.
+/// trunk.max_tilt_deg of vertical. Algorithm 2's start candidates and the trunk tracking's bases.
 bool isTrunkBase(const Cluster& cluster, double zmin, const ModelerConfig& config);
 
 /// @brief Recompute centroid, cylinder fit and error of a cluster.

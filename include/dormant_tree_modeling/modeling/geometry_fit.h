@@ -41,7 +41,7 @@ std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vecto
 std::optional<Circle> fitCircle(const Points2& pts);
 
 /// @brief Options of ransacCircle().
-struct CircleRansacOptions {
+struct CircleRansacConfig {
   double threshold = 0.005;  ///< m, inlier band around the circle
   int iterations = 200;
   double min_radius = 0.001;  ///< m
@@ -51,7 +51,7 @@ struct CircleRansacOptions {
 
 /// @brief RANSAC circle with radius bounds, refined on its inliers (within the bounds).
 /// @param inliers set to the indices of the inliers of the result
-std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacOptions& options,
+std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacConfig& options,
                                    std::vector<int>* inliers = nullptr);
 
 /// @brief The circle of a solid cross-section's surface when other things (branch bases,
@@ -79,7 +79,7 @@ Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid = nul
                               Eigen::Vector3d* eigenvalues = nullptr);
 
 /// @brief Options of ransacCylinder().
-struct CylinderRansacOptions {
+struct CylinderRansacConfig {
   double threshold = 0.01;  ///< m, inlier band |d - r|
   int circle_iterations = 150;
   int axis_candidates = 12;         ///< axis directions tried around the guess
@@ -95,7 +95,7 @@ struct CylinderRansacOptions {
 /// by fitCylinder() on its inliers. The radius stays within the bounds.
 /// @param inliers set to indices of the final inliers
 std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
-                                       const CylinderRansacOptions& options,
+                                       const CylinderRansacConfig& options,
                                        std::vector<int>* inliers = nullptr);
 
 /// @brief Radius corrected for range noise: sqrt(mean d^2 - sigma^2) over the points closer

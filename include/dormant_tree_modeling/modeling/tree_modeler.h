@@ -40,7 +40,7 @@ struct ModelResult {
   std::vector<TrunkCandidate> trunk_candidates;         ///< trunk bases tracked
 };
 
-/// @brief The configuration as the stages run it: validated, and with ours_correct_noise_bias
+/// @brief The configuration as the stages run it: validated, and with noise.correct_bias
 /// the radius tables filled (the noise part plus the calibration's footprint). For calling the
 /// stages (modelTrunk, modelBranches) directly as TreeModeler does.
 /// @throws Error INVALID_ARGUMENT

@@ -101,7 +101,7 @@ struct SliceCircle {
 /// within [min_radius, max_radius]. The noise model (noise_bias.h) runs this very estimator.
 /// @return nothing when RANSAC finds no circle
 std::optional<SliceCircle> measureSliceCircle(const Points2& plane,
-                                              const CircleRansacOptions& options, bool surface,
+                                              const CircleRansacConfig& options, bool surface,
                                               double min_radius, double max_radius);
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk

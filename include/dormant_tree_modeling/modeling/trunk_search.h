@@ -12,7 +12,7 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
-/// @brief One trunk base the modeler tracked (ours, ours_follow_diameter), for diagnostics.
+/// @brief One trunk base the modeler tracked (ours, graph.follow_diameter), for diagnostics.
 struct TrunkCandidate {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();  ///< where tracking began
   double start_radius = 0.0;       ///< the start's radius guess (m): its cluster's fitted radius

@@ -12,7 +12,7 @@ namespace dormant_tree_modeling {
 namespace registration {
 
 /// @brief How a folder of views is read.
-struct ViewFolderOptions {
+struct ViewFolderConfig {
   /// Keep only points within this horizontal distance (m) of where the view's guess expects
   /// the tree (the simulation tool writes whole views; the rows beyond only cost time). The
   /// guess may be 0.5 m off, hence a wide crop; <= 0 keeps everything.
@@ -47,7 +47,7 @@ constexpr std::size_t FEW_VIEW_POINTS = 100;
 /// @brief Read a folder of views. Views sharing a platform_index form a station; their poses
 /// within it come from the guesses (the slide moves are exact; only the platform is off).
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR naming the file
-ViewFolder readViewFolder(const std::string& dir, const ViewFolderOptions& options = {});
+ViewFolder readViewFolder(const std::string& dir, const ViewFolderConfig& options = {});
 
 /// @brief Pose errors of the registered views against the truth, relative to the first view.
 struct PoseErrors {

@@ -71,7 +71,7 @@ class ScanAssemblerNode {
 
   std::string rotary_axis_, rotary_joint_, move_service_, platform_frame_, stage_frame_,
       tree_frame_;
-  acquisition::SweepSettings sweep_;
+  acquisition::SweepConfig sweep_;
   double tree_distance_, max_missing_rows_;
   acquisition::ViewProcessingConfig processing_;
 

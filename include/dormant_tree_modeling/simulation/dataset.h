@@ -13,7 +13,7 @@ namespace dormant_tree_modeling {
 namespace simulation {
 
 /// @brief Everything that defines a synthetic scan of one tree.
-struct DatasetOptions {
+struct DatasetConfig {
   OrchardConfig orchard;
   std::uint64_t seed = 1;
   Lms111Config sensor;
@@ -48,7 +48,7 @@ Eigen::Isometry3d randomPlatformError(Rng& rng, double max_translation, double m
 /// merged.pcd / merged.ply (all views in the tree frame), target.pcd (the target tree cropped
 /// by its true extent plus a margin, as the paper cropped by hand) and preview.png.
 /// @throws Error on invalid options or when files cannot be written
-DatasetSummary writeDataset(const DatasetOptions& options, const std::string& dir);
+DatasetSummary writeDataset(const DatasetConfig& options, const std::string& dir);
 
 }  // namespace simulation
 }  // namespace dormant_tree_modeling

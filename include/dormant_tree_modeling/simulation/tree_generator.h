@@ -12,7 +12,7 @@ namespace simulation {
 
 /// @brief Shape parameters of a generated tree; every range is sampled uniformly per tree or
 /// per branch. Lengths in m, diameters in m, angles in degrees.
-struct TreeParams {
+struct TreeConfig {
   std::string preset;
   double height_min = 2.5, height_max = 4.0;                  ///< leader length
   double base_diameter_min = 0.04, base_diameter_max = 0.08;  ///< trunk at the ground
@@ -37,7 +37,7 @@ struct TreeParams {
 
 /// @brief Named presets: "young_tall_spindle", "mature_tall_spindle", "central_leader".
 /// @throws Error INVALID_ARGUMENT for an unknown name (the message lists the names)
-TreeParams presetParams(const std::string& name);
+TreeConfig presetParams(const std::string& name);
 
 /// @brief The names presetParams() accepts.
 std::vector<std::string> presetNames();
@@ -51,7 +51,7 @@ std::vector<std::string> variantPresetNames();
 /// @param seed equal seeds give equal trees
 /// @param base trunk base position (m)
 /// @param azimuth_offset rotates the branch layout (rad), so neighbours differ from the target
-TreeObject generateTree(const TreeParams& params, std::uint64_t seed, const Eigen::Vector3d& base,
+TreeObject generateTree(const TreeConfig& params, std::uint64_t seed, const Eigen::Vector3d& base,
                         double azimuth_offset = 0.0);
 
 /// @brief Ground truth of a generated tree (docs/evaluation.md): the trunk polyline, every

@@ -14,12 +14,12 @@ namespace dormant_tree_modeling {
 namespace simulation {
 
 /// @brief The scanning platform without hardware (architecture.md `virtual_platform`).
-struct VirtualPlatformOptions {
-  emulation::LmsServerOptions laser;  ///< ports of the LMS111 (CoLa-A, CoLa-B)
-  int stage_port = 8000;              ///< port of the Ensemble
-  double scan_frequency_hz = 25.0;    ///< the LMS111's power-up frequency (25 or 50)
-  double range_noise_sigma = 0.012;   ///< m
-  std::uint64_t seed = 1;             ///< sensor noise
+struct VirtualPlatformConfig {
+  emulation::LmsServerConfig laser;  ///< ports of the LMS111 (CoLa-A, CoLa-B)
+  int stage_port = 8000;             ///< port of the Ensemble
+  double scan_frequency_hz = 25.0;   ///< the LMS111's power-up frequency (25 or 50)
+  double range_noise_sigma = 0.012;  ///< m
+  std::uint64_t seed = 1;            ///< sensor noise
   /// The platform in the scene frame (platformPose); default: 1.5 m in front of the target
   /// tree, facing it, the laser at 1.5 m.
   Eigen::Isometry3d platform = geometry::platformPose(0.0, -1.5, 1.5, M_PI / 2);
@@ -39,7 +39,7 @@ struct VirtualPlatformOptions {
 class VirtualPlatform {
  public:
   /// @throws Error IO_FAILURE when a port cannot be bound, INVALID_ARGUMENT for bad options
-  VirtualPlatform(const Scene& scene, const VirtualPlatformOptions& options);
+  VirtualPlatform(const Scene& scene, const VirtualPlatformConfig& options);
   ~VirtualPlatform();
   int laserPort() const { return laser_->colaAPort(); }
   int laserColaBPort() const { return laser_->colaBPort(); }
