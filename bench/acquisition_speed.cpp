@@ -117,7 +117,7 @@ void BM_View(benchmark::State& state) {
   acquisition::SweepConfig s;
   s.continuous = continuous;
   // The first sweep starts from where homing left the stage: put it at one end first.
-  rig.io().move_rotary(s.theta_min - s.margin, 0.0);
+  rig.io().move_rotary(s.theta_min_deg - s.margin_deg, 0.0);
   acquisition::RangeImage image;
   for (auto _ : state) {
     try {

@@ -124,7 +124,7 @@ std::vector<TrunkCandidate> trunkCandidates(const Cloud& cloud, const Band& band
         sum += it == counts.end() ? 0 : it->second;
       }
     }
-    candidates.push_back({sum * std::exp(-0.5 * std::pow(off / c.hint_sigma, 2)), centre});
+    candidates.push_back({sum * std::exp(-0.5 * std::pow(off / c.hint_sigma_m, 2)), centre});
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const TrunkCandidate& a, const TrunkCandidate& b) { return a.score > b.score; });
@@ -212,7 +212,7 @@ std::vector<Point> crop(const Cloud& cloud, const Band& band,
     bool other = false;
     for (const auto& o : others)
       other = other || (xy - o).norm() < c.other_column_radius;
-    if (r > c.crop_radius || other || (band.ground_found && p.z > band.base + c.max_height)) {
+    if (r > c.crop_radius_m || other || (band.ground_found && p.z > band.base + c.max_height_m)) {
       ++out.outside_removed;
       continue;
     }
@@ -270,14 +270,14 @@ void IsolationConfig::validate() const {
           "ground_margin >= 0, 0 <= ground_min_fraction < 1, ground_hint_tolerance > 0");
   require(trunk_band_low < trunk_band_high, "trunk_band_low < trunk_band_high");
   require(cell > 0 && component_cell > 0, "cell sizes must be > 0");
-  require(hint_sigma > 0, "hint_sigma must be > 0");
+  require(hint_sigma_m > 0, "hint_sigma must be > 0");
   require(candidate_ratio > 0 && candidate_ratio <= 1 && max_candidates >= 1,
           "0 < candidate_ratio <= 1 and max_candidates >= 1");
   require(branch_ring_inner >= 0 && branch_ring_outer > branch_ring_inner &&
               branch_ring_high > branch_ring_low,
           "branch_ring_inner < branch_ring_outer and branch_ring_low < branch_ring_high");
   require(min_distance >= 0 && max_distance > min_distance, "0 <= min_distance < max_distance");
-  require(crop_radius > 0 && max_height > 0, "crop_radius and max_height must be > 0");
+  require(crop_radius_m > 0 && max_height_m > 0, "crop_radius and max_height must be > 0");
   require(trunk_clearance > 0 && other_column_radius > 0,
           "trunk_clearance and other_column_radius must be > 0");
 }

@@ -10,11 +10,6 @@ namespace dormant_tree_modeling {
 namespace acquisition {
 
 namespace {
-void require(bool ok, const std::string& what) {
-  if (!ok)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "view plan: " + what);
-}
-
 ConfigTable<ViewPlanConfig> makeTable() {
   using V = ViewPlanConfig;
   ConfigTable<V> t("view plan parameter", "");
@@ -50,10 +45,13 @@ int ViewPlanConfig::linesPerView() const {
 
 void ViewPlanConfig::validate() const {
   viewPlanConfigTable().check(*this);
-  require(slide_step_m * (slide_steps - 1) <= 2.0, "the slide travel must be at most 2 m");
-  require(front || back, "at least one of front/back");
-  require(theta_min_deg < theta_max_deg, "theta_min_deg must be below theta_max_deg");
-  require(linesPerView() >= 1, "the sweep must hold at least one theta_step_deg");
+  viewPlanConfigTable().require(slide_step_m * (slide_steps - 1) <= 2.0,
+                                "the slide travel must be at most 2 m");
+  viewPlanConfigTable().require(front || back, "at least one of front/back");
+  viewPlanConfigTable().require(theta_min_deg < theta_max_deg,
+                                "theta_min_deg must be below theta_max_deg");
+  viewPlanConfigTable().require(linesPerView() >= 1,
+                                "the sweep must hold at least one theta_step_deg");
 }
 
 std::vector<PlannedView> makeViewPlan(const ViewPlanConfig& config) {

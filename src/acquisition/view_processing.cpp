@@ -12,7 +12,7 @@ namespace dormant_tree_modeling {
 namespace acquisition {
 
 void ViewProcessingConfig::validate() const {
-  if (!(floating_threshold > 0))
+  if (!(floating_threshold_m > 0))
     throw Error(ErrorCode::INVALID_ARGUMENT, "floating_threshold (rho_T) must be > 0 m");
   if (smoothing_iterations < 0 || smoothing_iterations > 20)
     throw Error(ErrorCode::INVALID_ARGUMENT, "smoothing_iterations must be in 0..20");
@@ -29,9 +29,9 @@ ProcessedView processView(RangeImage& image, const Eigen::Isometry3d& stage_in_f
   out.valid_pixels = image.validCount();
   if (out.valid_pixels == 0)
     throw Error(ErrorCode::EMPTY_INPUT, "the view has no valid return");
-  out.floating_removed = removeFloatingPixels(image, c.floating_threshold);
+  out.floating_removed = removeFloatingPixels(image, c.floating_threshold_m);
   if (c.smoothing_iterations > 0)
-    smoothRanges(image, c.floating_threshold, c.smoothing_iterations);
+    smoothRanges(image, c.floating_threshold_m, c.smoothing_iterations);
   constexpr double DEG = M_PI / 180.0;
   const CloudPtr stage_cloud = toCloud(image, c.phi_min_deg * DEG, c.phi_max_deg * DEG);
   auto cloud = std::make_shared<Cloud>();

@@ -97,6 +97,10 @@ std::string formatValue(const std::vector<std::string>& v) {
   return s + "]";
 }
 
+std::string formatValue(const Eigen::Vector3d& v) {
+  return formatValue(std::vector<double>{v.x(), v.y(), v.z()});
+}
+
 std::string rangeText(double lo, double hi) {
   return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "]";
 }

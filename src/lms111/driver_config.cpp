@@ -9,11 +9,6 @@ namespace {
 
 constexpr const char* WHAT = "lms111 driver parameter";
 
-void require(bool ok, const std::string& message) {
-  if (!ok)
-    throw Error(ErrorCode::INVALID_ARGUMENT, std::string(WHAT) + " " + message);
-}
-
 ConfigTable<DriverConfig> makeDriverTable() {
   using D = DriverConfig;
   ConfigTable<D> t(WHAT, "");
@@ -79,23 +74,27 @@ const ConfigTable<DriverNodeConfig>& driverNodeConfigTable() {
 
 void DriverConfig::validate() const {
   driverConfigTable().check(*this);
-  require(!host.empty(), "host must not be empty");
-  require((scan_frequency_hz == 25.0 && angular_resolution_deg == 0.25) ||
-              (scan_frequency_hz == 50.0 && angular_resolution_deg == 0.5),
-          "scan_frequency_hz and angular_resolution_deg: the LMS111 runs 25 Hz with 0.25 deg "
-          "or 50 Hz with 0.5 deg (asked: " +
-              std::to_string(scan_frequency_hz) + " Hz, " + std::to_string(angular_resolution_deg) +
-              " deg)");
-  require(start_angle_deg < stop_angle_deg, "start_angle_deg must be below stop_angle_deg");
-  require((stopUnits() - startUnits()) % static_cast<std::int64_t>(resolutionUnits()) == 0,
-          "stop_angle_deg - start_angle_deg must be a multiple of the resolution");
-  require(reconnect_max_s >= reconnect_min_s, "reconnect_max_s must be at least reconnect_min_s");
+  driverConfigTable().require(!host.empty(), "host must not be empty");
+  driverConfigTable().require(
+      (scan_frequency_hz == 25.0 && angular_resolution_deg == 0.25) ||
+          (scan_frequency_hz == 50.0 && angular_resolution_deg == 0.5),
+      "scan_frequency_hz and angular_resolution_deg: the LMS111 runs 25 Hz with 0.25 deg "
+      "or 50 Hz with 0.5 deg (asked: " +
+          std::to_string(scan_frequency_hz) + " Hz, " + std::to_string(angular_resolution_deg) +
+          " deg)");
+  driverConfigTable().require(start_angle_deg < stop_angle_deg,
+                              "start_angle_deg must be below stop_angle_deg");
+  driverConfigTable().require(
+      (stopUnits() - startUnits()) % static_cast<std::int64_t>(resolutionUnits()) == 0,
+      "stop_angle_deg - start_angle_deg must be a multiple of the resolution");
+  driverConfigTable().require(reconnect_max_s >= reconnect_min_s,
+                              "reconnect_max_s must be at least reconnect_min_s");
 }
 
 void DriverNodeConfig::validate() const {
   device.validate();
   driverNodeConfigTable().check(*this);
-  require(range_max_m > range_min_m, "range_max_m must exceed range_min_m");
+  driverNodeConfigTable().require(range_max_m > range_min_m, "range_max_m must exceed range_min_m");
 }
 
 }  // namespace lms111

@@ -10,24 +10,21 @@ namespace {
 
 constexpr const char* WHAT = "tree modeler parameter";
 
-void require(bool ok, const std::string& message) {
-  if (!ok)
-    throw Error(ErrorCode::INVALID_ARGUMENT, std::string(WHAT) + " " + message);
-}
-
 void checkCalibration(const std::string& name, const RadiusCalibration& cal) {
+  const auto& table = modelerConfigTable();
   if (cal.radii.empty() && cal.noise.empty() && cal.bias.empty())
     return;  // no table: no correction
-  require(cal.valid(),
-          name + ": radii and noise must be ascending and non-empty, bias must hold " +
-              "noise x radii = " + std::to_string(cal.noise.size() * cal.radii.size()) +
-              " values (has " + std::to_string(cal.bias.size()) + ")");
+  table.require(cal.valid(),
+                name + ": radii and noise must be ascending and non-empty, bias must hold " +
+                    "noise x radii = " + std::to_string(cal.noise.size() * cal.radii.size()) +
+                    " values (has " + std::to_string(cal.bias.size()) + ")");
   for (const double b : cal.bias)
-    require(b >= -0.05 && b <= 0.05, name + " bias " + std::to_string(b) + " is outside ±0.05 m");
-  require(cal.radii.front() >= 1e-4 && cal.radii.back() <= 1.0,
-          name + " radii must lie in [0.0001, 1] m");
-  require(cal.noise.front() >= 0.0 && cal.noise.back() <= 0.1,
-          name + " noise must lie in [0, 0.1] m");
+    table.require(b >= -0.05 && b <= 0.05,
+                  name + " bias " + std::to_string(b) + " is outside ±0.05 m");
+  table.require(cal.radii.front() >= 1e-4 && cal.radii.back() <= 1.0,
+                name + " radii must lie in [0.0001, 1] m");
+  table.require(cal.noise.front() >= 0.0 && cal.noise.back() <= 0.1,
+                name + " noise must lie in [0, 0.1] m");
 }
 
 void addPreprocess(ConfigTable<ModelerConfig>& t) {
@@ -271,13 +268,15 @@ ModelerConfig ModelerConfig::paper() {
 }
 
 void ModelerConfig::validate() const {
-  modelerConfigTable().check(*this);
-  require(graph.n_high >= graph.n_low, "graph.n_high must be at least graph.n_low");
-  require(trunk.max_segment_length_m == 0.0 ||
-              trunk.max_segment_length_m >= 2.0 * trunk.min_segment_length_m,
-          "trunk.max_segment_length_m must be 0 or at least twice trunk.min_segment_length_m");
-  require(branches.max_steep_angle_deg >= branches.max_radial_angle_deg,
-          "branches.max_steep_angle_deg must be at least branches.max_radial_angle_deg");
+  const auto& table = modelerConfigTable();
+  table.check(*this);
+  table.require(graph.n_high >= graph.n_low, "graph.n_high must be at least graph.n_low");
+  table.require(
+      trunk.max_segment_length_m == 0.0 ||
+          trunk.max_segment_length_m >= 2.0 * trunk.min_segment_length_m,
+      "trunk.max_segment_length_m must be 0 or at least twice trunk.min_segment_length_m");
+  table.require(branches.max_steep_angle_deg >= branches.max_radial_angle_deg,
+                "branches.max_steep_angle_deg must be at least branches.max_radial_angle_deg");
   checkCalibration("trunk_calibration", trunk_calibration);
   checkCalibration("branch_calibration", branch_calibration);
 }

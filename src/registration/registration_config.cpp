@@ -9,11 +9,6 @@ namespace registration {
 
 namespace {
 
-void require(bool ok, const std::string& message) {
-  if (!ok)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "registration parameter " + message);
-}
-
 ConfigTable<IcpConfig> makeIcpTable() {
   using I = IcpConfig;
   ConfigTable<I> t("ICP parameter", "");
@@ -162,16 +157,17 @@ void CoarseSearchConfig::validate() const {
 
 void AxisConfig::validate() const {
   axisConfigTable().check(*this);
-  require(max_radius_m > min_radius_m, "axes.max_radius_m must exceed axes.min_radius_m");
-  require(std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
-          "silhouette growth (from the calibration) must be within ±0.05 m and ±0.05 m per m");
+  axisConfigTable().require(max_radius_m > min_radius_m, "max_radius_m must exceed min_radius_m");
+  axisConfigTable().require(
+      std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
+      "silhouette growth (from the calibration) must be within ±0.05 m and ±0.05 m per m");
 }
 
 void RegistrationConfig::validate() const {
   registrationConfigTable().check(*this);
   axes.validate();
-  require(candidate_levels <= static_cast<int>(icp.voxels_m.size()),
-          "candidate_levels must be at most the number of ICP levels");
+  registrationConfigTable().require(candidate_levels <= static_cast<int>(icp.voxels_m.size()),
+                                    "candidate_levels must be at most the number of ICP levels");
 }
 
 RegistrationConfig loadRegistrationConfig(const std::string& path) {

@@ -12,7 +12,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "dormant_tree_modeling/acquisition/node_configs.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -26,37 +28,24 @@ using Progress = dormant_tree_modeling::AcquisitionProgress;
 }  // namespace
 
 AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-  const std::string plan_file = pnh.param<std::string>("plan_file", "");
-  if (!plan_file.empty())
-    plan_ = acquisition::loadViewPlan(plan_file);
+  const auto config = readParameters(pnh, acquisition::acquisitionNodeConfigTable());
+  config.validate();
+  if (!config.plan_file.empty())
+    plan_ = acquisition::loadViewPlan(config.plan_file);
   plan_.validate();
-  output_dir_ = pnh.param<std::string>("output_dir", "scans");
-  tree_name_ = pnh.param<std::string>("tree_name", "tree");
-  move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
-  acquire_service_ =
-      pnh.param<std::string>("acquire_view_service", "/assembler/scan_assembler/acquire_view");
-  slide_axis_ = pnh.param<std::string>("slide_axis", "Y");
-  orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
-  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
-  slide_centre_ = pnh.param("slide_centre", 0.3);
-  slide_velocity_ = pnh.param("slide_velocity", 0.0);
-  if (!(slide_velocity_ >= 0 && slide_velocity_ <= 1))
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "~slide_velocity must be in 0..1 m/s (0: the stage's default)");
-  max_retries_ = pnh.param("max_retries", 2);
-  drain_s_ = pnh.param("drain_seconds", 1.0);
-  service_wait_s_ = pnh.param("service_wait", 30.0);
-  topics_ = pnh.param<std::vector<std::string>>(
-      "record_topics", {"/lms111/scan", "/stage/joint_states", "/tf", "/tf_static",
-                        "/assembler/view_cloud", "/acquisition/progress"});
-  if (tree_name_.empty() || tree_name_.find('/') != std::string::npos)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~tree_name must be a plain file name");
-  if (max_retries_ < 0 || max_retries_ > 10)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~max_retries must be in 0..10");
-  if (drain_s_ < 0 || drain_s_ > 60)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~drain_seconds must be in 0..60");
-  if (!(service_wait_s_ > 0 && service_wait_s_ <= 600))
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~service_wait must be in (0, 600] s");
+  output_dir_ = config.output_dir;
+  tree_name_ = config.tree_name;
+  move_service_ = config.move_axis_service;
+  acquire_service_ = config.acquire_view_service;
+  slide_axis_ = config.slide_axis;
+  orchard_frame_ = config.orchard_frame;
+  platform_frame_ = config.platform_frame;
+  slide_centre_ = config.slide_centre_m;
+  slide_velocity_ = config.slide_velocity_mps;
+  max_retries_ = config.max_retries;
+  drain_s_ = config.drain_s;
+  service_wait_s_ = config.service_wait_s;
+  topics_ = config.record_topics;
   prompt_pub_ = pnh.advertise<std_msgs::String>("prompt", 1, true);
   progress_pub_ = pnh.advertise<dormant_tree_modeling::AcquisitionProgress>("progress", 1, true);
   goal_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_goal", 1, true);
@@ -79,7 +68,7 @@ AcquisitionNode::AcquisitionNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh
   diagnostics_.start(nh, "none");
   platform_tf_timer_ = nh.createTimer(ros::Duration(1.0 / PLATFORM_TF_HZ),
                                       [this](const ros::TimerEvent&) { republishPlatform(); });
-  if (pnh.param("autostart", false)) {
+  if (config.autostart) {
     running_ = true;
     worker_ = std::thread([this] { run(); });
   }

@@ -6,20 +6,18 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
 
 CloudFilePublisher::CloudFilePublisher(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string& file = file_;
-  if (!pnh.getParam("file", file) || file.empty()) {
-    throw Error(ErrorCode::INVALID_ARGUMENT, "parameter ~file is required (a .pcd, .ply or .xyz)");
-  }
-  const std::string frame_id = pnh.param<std::string>("frame_id", "orchard");
-  const double rate = pnh.param("rate", 0.0);
-  if (!(rate >= 0.0)) {
-    throw Error(ErrorCode::INVALID_ARGUMENT, "parameter ~rate must be >= 0 Hz (0: publish once)");
-  }
+  const auto config = readParameters(pnh, io::cloudPublisherConfigTable());
+  config.validate();
+  file_ = config.file;
+  const std::string& file = file_;
+  const std::string& frame_id = config.frame_id;
+  const double rate = config.rate_hz;
   const auto loaded = io::readCloud(file);
   if (loaded.dropped_non_finite > 0) {
     ROS_WARN("%s: dropped %zu NaN/Inf points of %zu", file.c_str(), loaded.dropped_non_finite,

@@ -13,8 +13,10 @@
 
 #include "dormant_tree_modeling/acquisition/sequencer.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/registration/node_config.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
@@ -25,30 +27,32 @@ namespace {
 // How often the end of the input is looked for, s.
 constexpr double END_OF_INPUT_CHECK_S = 1.0;
 
-/// The silhouette growth of ~calibration_file's sensor calibration; none (said) without one.
-registration::RegistrationConfig withCalibration(registration::RegistrationConfig config,
-                                                 ros::NodeHandle& pnh) {
-  const std::string file = pnh.param<std::string>("calibration_file", "");
-  const bool applied = !file.empty() && registration::applySensorCalibration(
-                                            modeling::loadSensorCalibration(file), config);
+/// The registration settings and the silhouette growth of the files the node's parameters name.
+registration::RegistrationConfig loadConfig(const registration::RegistrationNodeConfig& node) {
+  registration::RegistrationConfig config;
+  if (node.config_file.empty()) {
+    ROS_WARN(
+        "~config_file not set: using the built-in defaults (config/registration.yaml holds "
+        "them too)");
+  } else {
+    config = registration::loadRegistrationConfig(node.config_file);
+  }
+  const bool applied = !node.calibration_file.empty() &&
+                       registration::applySensorCalibration(
+                           modeling::loadSensorCalibration(node.calibration_file), config);
   if (!applied) {
     ROS_WARN(
         "registration: no silhouette growth in ~calibration_file ('%s'): branch axes assume "
         "an ideal beam (calibrate the rig's views with calibrate_diameters)",
-        file.c_str());
+        node.calibration_file.c_str());
   }
   return config;
 }
 
-registration::RegistrationConfig loadConfig(ros::NodeHandle& pnh) {
-  const std::string file = pnh.param<std::string>("config_file", "");
-  if (file.empty()) {
-    ROS_WARN(
-        "~config_file not set: using the built-in defaults (config/registration.yaml holds "
-        "them too)");
-    return withCalibration(registration::RegistrationConfig{}, pnh);
-  }
-  return withCalibration(registration::loadRegistrationConfig(file), pnh);
+registration::RegistrationNodeConfig readNodeConfig(const ros::NodeHandle& pnh) {
+  auto node = readParameters(pnh, registration::registrationNodeConfigTable());
+  node.validate();
+  return node;
 }
 
 std::string defaultOutputDir() {
@@ -82,35 +86,26 @@ std::optional<PlanEnd> planEnd(const topic_tools::ShapeShifter& msg) {
 }
 
 RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : config_(loadConfig(pnh)), nh_(nh) {
-  orchard_frame_ = pnh.param<std::string>("orchard_frame", "orchard");
-  tree_frame_ = pnh.param<std::string>("tree_frame", "tree");
-  laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
-  output_dir_ = pnh.param<std::string>("output_dir", defaultOutputDir());
-  expected_views_ = pnh.param<int>("expected_views", 0);
-  hint_timeout_ = pnh.param<double>("hint_timeout", 0.5);
-  finished_wait_ = pnh.param<double>("finished_wait", 10.0);
-  end_of_input_timeout_ = pnh.param<double>("end_of_input_timeout", 0.0);
-  const std::string input_topic = pnh.param<std::string>("input_watch_topic", "");
-  if (expected_views_ < 0)
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "~expected_views must be >= 0 (0: no automatic "
-                "registration by count)");
-  if (!(hint_timeout_ >= 0))
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~hint_timeout must be >= 0 s");
-  if (!(finished_wait_ >= 0))
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~finished_wait must be >= 0 s");
-  if (!(end_of_input_timeout_ >= 0))
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~end_of_input_timeout must be >= 0 s (0: off)");
-  if (tree_frame_.empty() || orchard_frame_.empty() || tree_frame_ == orchard_frame_)
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "~tree_frame and ~orchard_frame must be two different, non-empty frame names");
+    : RegistrationNode(nh, pnh, readNodeConfig(pnh)) {}
+
+RegistrationNode::RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+                                   const registration::RegistrationNodeConfig& node)
+    : config_(loadConfig(node)), nh_(nh) {
+  orchard_frame_ = node.orchard_frame;
+  tree_frame_ = node.tree_frame;
+  laser_frame_ = node.laser_frame;
+  output_dir_ = node.output_dir.empty() ? defaultOutputDir() : node.output_dir;
+  expected_views_ = node.expected_views;
+  hint_timeout_ = node.hint_timeout_s;
+  finished_wait_ = node.finished_wait_s;
+  end_of_input_timeout_ = node.end_of_input_timeout_s;
+  const std::string& input_topic = node.input_watch_topic;
 
   cloud_pub_ = pnh.advertise<sensor_msgs::PointCloud2>("tree_cloud", 1, true);
   poses_pub_ = pnh.advertise<geometry_msgs::PoseArray>("view_poses", 1, true);
   report_pub_ = pnh.advertise<std_msgs::String>("report", 1, true);
   view_sub_ = nh.subscribe("view_cloud", 50, &RegistrationNode::viewCallback, this);
-  const std::string progress = pnh.param<std::string>("plan_progress_topic", "");
+  const std::string& progress = node.plan_progress_topic;
   if (!progress.empty())
     progress_sub_ = nh.subscribe<topic_tools::ShapeShifter>(
         progress, 10, &RegistrationNode::progressCallback, this);

@@ -11,9 +11,11 @@
 #include <cstring>
 #include <sstream>
 
+#include "dormant_tree_modeling/acquisition/node_configs.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/lms111/laser_scan.h"
 #include "dormant_tree_modeling/ros/conversions.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
@@ -33,41 +35,23 @@ constexpr double LINE_WAIT_WARN_S = 10.0;
 }  // namespace
 
 ScanAssemblerNode::ScanAssemblerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-  const std::string mode = pnh.param<std::string>("mode", "continuous");
-  if (mode != "continuous" && mode != "step")
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~mode must be continuous or step, is " + mode);
-  sweep_.continuous = mode == "continuous";
-  rotary_axis_ = pnh.param<std::string>("rotary_axis", "X");
-  rotary_joint_ = pnh.param<std::string>("rotary_joint", "rotary_stage_joint");
-  move_service_ = pnh.param<std::string>("move_axis_service", "/stage/stage_controller/move_axis");
-  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
-  tree_frame_ = pnh.param<std::string>("tree_frame", "orchard");
-  stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
-  sweep_.theta_min = pnh.param("theta_min", sweep_.theta_min);
-  sweep_.theta_max = pnh.param("theta_max", sweep_.theta_max);
-  sweep_.theta_step = pnh.param("theta_step", sweep_.theta_step);
-  sweep_.margin = pnh.param("sweep_margin", sweep_.margin);
-  sweep_.settle_s = pnh.param("settle_time", sweep_.settle_s);
-  sweep_.validate();
-  tree_distance_ = pnh.param("tree_distance", 1.5);
-  max_missing_rows_ = pnh.param("max_missing_rows", 0.05);
-  const double buffer_s = pnh.param("buffer_seconds", 60.0);
-  if (!(tree_distance_ > 0 && buffer_s > 10 && max_missing_rows_ >= 0 && max_missing_rows_ < 1))
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "need tree_distance > 0, buffer_seconds > 10 and 0 <= max_missing_rows < 1");
-  auto& p = processing_;
-  p.floating_threshold = pnh.param("floating_threshold", p.floating_threshold);
-  p.smoothing_iterations = pnh.param("smoothing_iterations", p.smoothing_iterations);
-  p.isolate = pnh.param("isolate", p.isolate);
-  p.isolation.crop_radius = pnh.param("crop_radius", p.isolation.crop_radius);
-  p.isolation.hint_sigma = pnh.param("hint_sigma", p.isolation.hint_sigma);
-  p.isolation.max_height = pnh.param("max_height", p.isolation.max_height);
-  p.validate();
-  recorder_ = std::make_unique<acquisition::SweepRecorder>(buffer_s);
-  passive_ = pnh.param("passive", false);
+  const auto config = readParameters(pnh, acquisition::assemblerConfigTable());
+  config.validate();
+  sweep_ = config.sweep;
+  processing_ = config.processing;
+  rotary_axis_ = config.rotary_axis;
+  rotary_joint_ = config.rotary_joint;
+  move_service_ = config.move_axis_service;
+  platform_frame_ = config.platform_frame;
+  tree_frame_ = config.tree_frame;
+  stage_frame_ = config.rotary_stage_frame;
+  tree_distance_ = config.tree_distance_m;
+  max_missing_rows_ = config.max_missing_rows;
+  recorder_ = std::make_unique<acquisition::SweepRecorder>(config.buffer_s);
+  passive_ = config.passive;
   if (passive_) {
-    watcher_ =
-        std::make_unique<acquisition::SweepWatcher>(sweep_.theta_min * DEG, sweep_.theta_max * DEG);
+    watcher_ = std::make_unique<acquisition::SweepWatcher>(sweep_.theta_min_deg * DEG,
+                                                           sweep_.theta_max_deg * DEG);
     worker_ = std::thread([this] { passiveLoop(); });
   }
 
@@ -148,8 +132,8 @@ void ScanAssemblerNode::passiveLoop() {
       std::size_t dropped = 0, missing = 0;
       const acquisition::RangeImage image = acquisition::assembleRangeImage(
           recorder_->linesBetween(sweep.begin, sweep.end), recorder_->history(),
-          sweep_.theta_min * DEG, sweep_.theta_max * DEG, &dropped, sweep_.theta_step * DEG,
-          &missing);
+          sweep_.theta_min_deg * DEG, sweep_.theta_max_deg * DEG, &dropped,
+          sweep_.theta_step_deg * DEG, &missing);
       if (image.rows == 0)
         throw Error(ErrorCode::EMPTY_INPUT, "no scan line of the sweep had stage positions");
       const std::string summary = publishView(image, dropped, missing, started);

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 
 namespace dormant_tree_modeling {
 namespace ros_layer {
@@ -19,43 +20,6 @@ constexpr double STOP_DEADLINE_S = 0.6;
 // Longest sleep between two looks at the stop flag, s.
 constexpr double STOP_POLL_S = 0.05;
 constexpr double HEALTH_PERIOD_S = 1.0;
-
-Eigen::Vector3d vectorParam(ros::NodeHandle& pnh, const std::string& name) {
-  std::vector<double> v;
-  if (!pnh.getParam(name, v))
-    return Eigen::Vector3d::Zero();
-  if (v.size() != 3)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~" + name + " must be [x, y, z] in m");
-  return Eigen::Vector3d(v[0], v[1], v[2]);
-}
-
-void readAxis(ros::NodeHandle& pnh, const std::string& ns, aerotech::StageAxisConfig& a) {
-  a.axis = pnh.param(ns + "/axis", a.axis);
-  a.joint = pnh.param(ns + "/joint", a.joint);
-  a.scale = pnh.param(ns + "/scale", a.scale);
-  a.default_velocity = pnh.param(ns + "/default_velocity", a.default_velocity);
-  a.min_position = pnh.param(ns + "/min_position", a.min_position);
-  a.max_position = pnh.param(ns + "/max_position", a.max_position);
-}
-
-aerotech::StageConfig readConfig(ros::NodeHandle& pnh) {
-  aerotech::StageConfig c;
-  c.controller.host = pnh.param("host", c.controller.host);
-  c.controller.port = pnh.param("port", c.controller.port);
-  c.controller.connect_timeout_s = pnh.param("connect_timeout", c.controller.connect_timeout_s);
-  c.controller.reply_timeout_s = pnh.param("reply_timeout", c.controller.reply_timeout_s);
-  c.controller.home_timeout_s = pnh.param("home_timeout", c.controller.home_timeout_s);
-  readAxis(pnh, "rotary", c.rotary);
-  readAxis(pnh, "slide", c.slide);
-  c.geometry.platform_to_slide_base = vectorParam(pnh, "platform_to_slide_base");
-  c.geometry.carriage_to_stage = vectorParam(pnh, "carriage_to_stage");
-  c.geometry.stage_to_laser = vectorParam(pnh, "stage_to_laser");
-  c.joint_state_rate = pnh.param("joint_state_rate", c.joint_state_rate);
-  c.home_on_start = pnh.param("home_on_start", c.home_on_start);
-  c.move_timeout_margin_s = pnh.param("move_timeout_margin", c.move_timeout_margin_s);
-  c.validate();
-  return c;
-}
 
 geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
                                           const Eigen::Vector3d& t, const Eigen::Quaterniond& q,
@@ -93,18 +57,16 @@ std::uint8_t moveStatus(aerotech::MoveStatus status) {
 }  // namespace
 
 StageControllerNode::StageControllerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  stage_ = std::make_unique<aerotech::StageController>(readConfig(pnh));
-  platform_frame_ = pnh.param<std::string>("platform_frame", "platform");
-  slide_base_frame_ = pnh.param<std::string>("slide_base_frame", "slide_base");
-  carriage_frame_ = pnh.param<std::string>("slide_carriage_frame", "slide_carriage");
-  stage_frame_ = pnh.param<std::string>("rotary_stage_frame", "rotary_stage");
-  laser_frame_ = pnh.param<std::string>("laser_frame", "laser");
-  reconnect_min_s_ = pnh.param("reconnect_min", reconnect_min_s_);
-  reconnect_max_s_ = pnh.param("reconnect_max", reconnect_max_s_);
-  if (!(reconnect_min_s_ > 0 && reconnect_max_s_ >= reconnect_min_s_)) {
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "stage_controller: need 0 < ~reconnect_min <= ~reconnect_max (s)");
-  }
+  const auto config = readParameters(pnh, aerotech::stageNodeConfigTable());
+  config.validate();
+  stage_ = std::make_unique<aerotech::StageController>(config.stage);
+  platform_frame_ = config.platform_frame;
+  slide_base_frame_ = config.slide_base_frame;
+  carriage_frame_ = config.slide_carriage_frame;
+  stage_frame_ = config.rotary_stage_frame;
+  laser_frame_ = config.laser_frame;
+  reconnect_min_s_ = config.reconnect_min_s;
+  reconnect_max_s_ = config.reconnect_max_s;
   joint_pub_ = nh.advertise<sensor_msgs::JointState>("joint_states", 50);
   move_srv_ = pnh.advertiseService("move_axis", &StageControllerNode::moveAxis, this);
   home_srv_ = pnh.advertiseService("home", &StageControllerNode::home, this);
@@ -191,7 +153,7 @@ void StageControllerNode::setUpLoop() {
 
 void StageControllerNode::feedbackLoop() {
   const auto& c = stage_->config();
-  ros::WallRate rate(c.joint_state_rate);
+  ros::WallRate rate(c.joint_state_rate_hz);
   ros::WallTime last_health(0.0), window_start = ros::WallTime::now();
   int samples = 0;
   double backoff = reconnect_min_s_;

@@ -11,12 +11,15 @@
 #include <filesystem>
 #include <sstream>
 
+#include "dormant_tree_modeling/common/config_table.h"
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/cylinder_csv.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/modeling/node_config.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/ros/model_messages.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
 namespace dormant_tree_modeling {
@@ -24,30 +27,27 @@ namespace ros_layer {
 
 namespace {
 
-/// The sensor calibration of ~calibration_file; none (said once) when it is empty.
-modeling::ModelerConfig withCalibration(modeling::ModelerConfig config, ros::NodeHandle& pnh) {
-  const std::string file = pnh.param<std::string>("calibration_file", "");
-  if (file.empty()) {
+/// The modeler's parameters and sensor calibration from the files the node's parameters name.
+modeling::ModelerConfig loadConfig(const modeling::TreeModelerNodeConfig& node) {
+  modeling::treeModelerNodeConfigTable().check(node);
+  modeling::ModelerConfig config;
+  if (node.config_file.empty()) {
+    ROS_WARN(
+        "~config_file not set: using the built-in defaults (config/tree_modeler.yaml holds them "
+        "too)");
+  } else {
+    config = modeling::loadModelerConfig(node.config_file);
+  }
+  if (node.calibration_file.empty()) {
     ROS_WARN(
         "~calibration_file not set: diameters are corrected for range noise only, not for the "
         "scanner's beam footprint (make a calibration with calibrate_diameters)");
     return config;
   }
-  config.calibration = modeling::loadSensorCalibration(file);
+  config.calibration = modeling::loadSensorCalibration(node.calibration_file);
   ROS_INFO("tree_modeler: sensor calibration '%s' (%s) from %s", config.calibration.name.c_str(),
-           config.calibration.hash.c_str(), file.c_str());
+           config.calibration.hash.c_str(), node.calibration_file.c_str());
   return config;
-}
-
-modeling::ModelerConfig loadConfig(ros::NodeHandle& pnh) {
-  const std::string file = pnh.param<std::string>("config_file", "");
-  if (file.empty()) {
-    ROS_WARN(
-        "~config_file not set: using the built-in defaults (config/tree_modeler.yaml holds them "
-        "too)");
-    return withCalibration(modeling::ModelerConfig{}, pnh);
-  }
-  return withCalibration(modeling::loadModelerConfig(file), pnh);
 }
 
 sensor_msgs::PointCloud2 segmentsMsg(const modeling::ModelResult& result,
@@ -74,12 +74,14 @@ sensor_msgs::PointCloud2 segmentsMsg(const modeling::ModelResult& result,
 }  // namespace
 
 TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : modeler_(loadConfig(pnh)) {
-  output_dir_ = pnh.param<std::string>("output_dir", "");
-  output_frame_ = pnh.param<std::string>("output_frame", "");
-  exit_after_models_ = pnh.param<int>("exit_after_models", 0);
-  if (exit_after_models_ < 0)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~exit_after_models must be >= 0 (0: never)");
+    : TreeModelerNode(nh, pnh, readParameters(pnh, modeling::treeModelerNodeConfigTable())) {}
+
+TreeModelerNode::TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+                                 const modeling::TreeModelerNodeConfig& node)
+    : modeler_(loadConfig(node)) {
+  output_dir_ = node.output_dir;
+  output_frame_ = node.output_frame;
+  exit_after_models_ = node.exit_after_models;
   if (!output_dir_.empty())
     std::filesystem::create_directories(output_dir_);
   diagnostics_.add("tree modeler", this, &TreeModelerNode::diagnose);

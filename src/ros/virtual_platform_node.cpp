@@ -11,6 +11,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/pose_json.h"
 #include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/ros/node_support.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 #include "dormant_tree_modeling/simulation/orchard_generator.h"
 #include "dormant_tree_modeling/simulation/scene.h"
@@ -21,13 +22,6 @@ namespace ros_layer {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-
-int portParam(ros::NodeHandle& pnh, const std::string& name, int fallback) {
-  const int port = pnh.param(name, fallback);
-  if (port < -1 || port > 65535)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~" + name + " must be a port (0: any, -1: off)");
-  return port;
-}
 
 std::string describe(const Eigen::Isometry3d& pose) {
   const Eigen::Vector3d t = pose.translation();
@@ -41,41 +35,29 @@ std::string describe(const Eigen::Isometry3d& pose) {
 }  // namespace
 
 VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  const auto config = readParameters(pnh, simulation::virtualPlatformNodeConfigTable());
+  config.validate();
   simulation::VirtualPlatformConfig o;
-  o.laser.cola_a_port = portParam(pnh, "lms_port", 2111);
-  o.laser.cola_b_port = portParam(pnh, "lms_b_port", 2112);
-  o.stage_port = portParam(pnh, "aerotech_port", 8000);
-  o.scan_frequency_hz = pnh.param("frequency", 25.0);
-  const double noise_mm = pnh.param("noise_mm", 12.0);
-  if (!(noise_mm >= 0 && noise_mm <= 100))
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~noise_mm must be in 0..100 (mm, 1 sigma)");
-  o.range_noise_sigma = noise_mm / 1000.0;
-  const int seed = pnh.param("seed", 1);
-  if (seed < 0)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~seed must be >= 0");
-  o.seed = static_cast<std::uint64_t>(seed);
-  const std::vector<double> start =
-      pnh.param<std::vector<double>>("platform", {0.0, -1.5, 1.5, 90.0});
-  if (start.size() != 4)
-    throw Error(ErrorCode::INVALID_ARGUMENT, "~platform takes [x, y, z, yaw_deg]");
+  o.laser.cola_a_port = config.lms_port;
+  o.laser.cola_b_port = config.lms_b_port;
+  o.stage_port = config.aerotech_port;
+  o.scan_frequency_hz = config.scan_frequency_hz;
+  o.range_noise_sigma = config.noise_mm / 1000.0;
+  o.seed = static_cast<std::uint64_t>(config.seed);
+  const auto& start = config.platform;
   o.platform = geometry::platformPose(start[0], start[1], start[2], start[3] * DEG);
-  o.stage_faults.fault_axis = pnh.param<std::string>("fault_axis", "");
-  o.stage_faults.fault_on_move = pnh.param("fault_on_move", 0);
-  scene_frame_ = pnh.param<std::string>("scene_frame", "orchard");
-  output_dir_ = pnh.param<std::string>("output_dir", "");
-  in_place_service_ = pnh.param<std::string>("in_place_service", "/acquisition/platform_in_place");
-  placement_error_ = pnh.param("placement_error", 0.2);
-  placement_error_yaw_deg_ = pnh.param("placement_error_yaw", 8.0);
-  settle_s_ = pnh.param("settle_time", 0.5);
-  if (!(placement_error_ >= 0 && placement_error_ <= 2 && placement_error_yaw_deg_ >= 0 &&
-        placement_error_yaw_deg_ <= 180 && settle_s_ >= 0 && settle_s_ <= 60))
-    throw Error(ErrorCode::INVALID_ARGUMENT,
-                "need 0 <= ~placement_error <= 2 m, 0 <= ~placement_error_yaw <= 180 deg, "
-                "0 <= ~settle_time <= 60 s");
+  o.stage_faults.fault_axis = config.fault_axis;
+  o.stage_faults.fault_on_move = config.fault_on_move;
+  scene_frame_ = config.scene_frame;
+  output_dir_ = config.output_dir;
+  in_place_service_ = config.in_place_service;
+  placement_error_ = config.placement_error_m;
+  placement_error_yaw_deg_ = config.placement_error_yaw_deg;
+  settle_s_ = config.settle_time_s;
   placement_rng_ = Rng::derive(o.seed, 17);
 
-  const std::string scene_file = pnh.param<std::string>("scene_file", "");
-  const std::string preset = pnh.param<std::string>("preset", "young_tall_spindle");
+  const std::string& scene_file = config.scene_file;
+  const std::string& preset = config.preset;
   const simulation::SceneAndTruth scene =
       simulation::sceneFromFileOrPreset(scene_file, preset, o.seed);
   if (!output_dir_.empty()) {
@@ -88,9 +70,8 @@ VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& p
 
   pose_pub_ = pnh.advertise<geometry_msgs::PoseStamped>("platform_pose", 1, true);
   move_srv_ = pnh.advertiseService("move_platform", &VirtualPlatformNode::movePlatform, this);
-  if (pnh.param("follow_goals", false)) {
-    goal_sub_ = nh.subscribe(pnh.param<std::string>("goal_topic", "/acquisition/platform_goal"), 10,
-                             &VirtualPlatformNode::goalCallback, this);
+  if (config.follow_goals) {
+    goal_sub_ = nh.subscribe(config.goal_topic, 10, &VirtualPlatformNode::goalCallback, this);
   }
   place(o.platform, nullptr);
   diagnostics_.add("virtual platform", this, &VirtualPlatformNode::diagnose);
@@ -99,7 +80,7 @@ VirtualPlatformNode::VirtualPlatformNode(ros::NodeHandle& nh, ros::NodeHandle& p
       "virtual_platform: LMS111 on 127.0.0.1:%d (CoLa-A), %d (CoLa-B); Aerotech on "
       "127.0.0.1:%d; %s; platform at %s%s",
       platform_->laserPort(), platform_->laserColaBPort(), platform_->stagePort(),
-      scene_file.empty() ? ("preset " + preset + ", seed " + std::to_string(seed)).c_str()
+      scene_file.empty() ? ("preset " + preset + ", seed " + std::to_string(config.seed)).c_str()
                          : scene_file.c_str(),
       describe(o.platform).c_str(),
       goal_sub_ ? ("; following goals on " + goal_sub_.getTopic()).c_str() : "");

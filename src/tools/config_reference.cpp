@@ -7,11 +7,17 @@
 #include <sstream>
 
 #include "command_line.h"
+#include "dormant_tree_modeling/acquisition/node_configs.h"
 #include "dormant_tree_modeling/acquisition/view_plan.h"
+#include "dormant_tree_modeling/aerotech/stage_config.h"
 #include "dormant_tree_modeling/common/config_table.h"
+#include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/lms111/driver.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
+#include "dormant_tree_modeling/modeling/node_config.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/node_config.h"
+#include "dormant_tree_modeling/simulation/virtual_platform.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
@@ -42,7 +48,8 @@ std::string configurationDoc() {
        "key keeps the default below), an unknown key or a value of the wrong type is an error "
        "that names the file and the key, and a key renamed since names its new name. Values "
        "outside their range are refused with the key, the value and the range. Names carry "
-       "their unit: `_m` metres, `_deg` degrees, `_s` seconds, `_hz` hertz; shares and counts "
+       "their unit: `_m` metres, `_deg` degrees, `_s` seconds, `_hz` hertz, `_mps` metres per "
+       "second; shares and counts "
        "have none.\n\n"
        "The scanner's diameter calibration is a file of its own (`config/calibration/`, made by "
        "`calibrate_diameters`, see [calibration.md](calibration.md)), not a parameter.\n\n";
@@ -59,13 +66,42 @@ std::string configurationDoc() {
                "The acquisition plan of the paper's Algorithm 1: the `acquisition` node's "
                "`~plan_file`, `synth_tree --views FILE`.",
                acquisition::viewPlanConfigTable());
-  s << section("LMS111 driver node", "config/lms111_driver.yaml",
-               "The `lms111_driver` node's private parameters (`launch/lms111_driver.launch` "
-               "loads the file and sets host, port, protocol and the scan rate from its "
-               "arguments). A parameter the node does not know is reported as a warning; one "
-               "set under its name before the units were added stops the node with the new "
-               "name.",
+  s << "## Node parameters\n\n"
+       "Each node reads its private parameters through the same tables: a parameter of the "
+       "wrong type stops the node with its name, one the node does not know is reported as a "
+       "warning, and one still set under its name from before the units were added stops the "
+       "node with the new name. Groups are namespaces (`~rotary/axis`).\n\n";
+  s << section("LMS111 driver", "config/lms111_driver.yaml",
+               "`launch/lms111_driver.launch` loads the file and sets host, port, protocol and "
+               "the scan rate from its arguments.",
                lms111::driverNodeConfigTable());
+  s << section("Stage controller", "config/stage_controller.yaml",
+               "`launch/stage_controller.launch` loads the file and sets host, port and "
+               "home_on_start from its arguments. Positions are in service units: deg for the "
+               "rotary stage, m for the slide.",
+               aerotech::stageNodeConfigTable());
+  s << section("Scan assembler", "config/scan_assembler.yaml",
+               "`launch/scan_assembler.launch` loads the file and sets the mode; "
+               "`launch/replay.launch` sets `passive`.",
+               acquisition::assemblerConfigTable());
+  s << section("Acquisition", "launch/acquisition.launch",
+               "Set by `launch/acquisition.launch` from its arguments (no file of its own).",
+               acquisition::acquisitionNodeConfigTable());
+  s << section("Registration node", "launch/registration.launch",
+               "Set by `launch/registration.launch`; the registration's own settings are in "
+               "`config_file`.",
+               registration::registrationNodeConfigTable());
+  s << section("Tree modeler node", "launch/tree_modeler.launch",
+               "Set by `launch/tree_modeler.launch`; the modeler's own parameters are in "
+               "`config_file`.",
+               modeling::treeModelerNodeConfigTable());
+  s << section("Cloud file publisher", "launch/model_file.launch",
+               "Publishes a cloud file for the tree modeler node (`launch/model_file.launch`).",
+               io::cloudPublisherConfigTable());
+  s << section("Virtual platform", "launch/virtual_platform.launch",
+               "The emulated LMS111 and Ensemble and the simulated tree row "
+               "(`launch/virtual_platform.launch`, `make demo`).",
+               simulation::virtualPlatformNodeConfigTable());
   return s.str();
 }
 
@@ -97,6 +133,19 @@ std::vector<GeneratedFile> generatedFiles() {
                        "in the device's convention: 0 deg straight down, 90 deg ahead, 180 deg "
                        "up; the published LaserScan is rotated by -90 deg (ROS: x ahead). ") +
                GENERATED)},
+      {"config/stage_controller.yaml",
+       aerotech::stageNodeConfigTable().yaml(
+           aerotech::StageNodeConfig{},
+           std::string("Aerotech Ensemble stage (stage_controller node; docs/configuration.md): "
+                       "ART310 rotary stage and ATS02060 linear slide. Positions in service "
+                       "units: deg for the rotary stage, m for the slide. ") +
+               GENERATED)},
+      {"config/scan_assembler.yaml",
+       acquisition::assemblerConfigTable().yaml(
+           acquisition::AssemblerConfig{},
+           std::string("Scan assembler (scan_assembler node; docs/configuration.md): one "
+                       "rotary sweep -> one view. Angles in degrees. ") +
+               GENERATED)},
       {"docs/configuration.md", configurationDoc()},
   };
 }
@@ -115,7 +164,7 @@ int main(int argc, char** argv) {
   po::options_description desc(
       "Usage: config_reference (--write ROOT | --check ROOT)\n"
       "Writes, or checks, config/tree_modeler.yaml, config/registration.yaml, "
-      "config/view_plan.yaml, config/lms111_driver.yaml and docs/configuration.md under the "
+      "config/view_plan.yaml, the nodes' config/*.yaml and docs/configuration.md under the "
       "repository root ROOT from the "
       "parameter tables of the code");
   desc.add_options()("help,h", "this help")("write", po::value(&write_root),

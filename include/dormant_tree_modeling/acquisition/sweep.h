@@ -12,10 +12,12 @@ namespace acquisition {
 
 /// @brief How a view's rotary sweep is run (angles in degrees).
 struct SweepConfig {
-  bool continuous = true;  ///< false: step-and-scan (the paper's)
-  double theta_min = -45.0, theta_max = 45.0, theta_step = 0.45;
-  double margin = 0.5;     ///< past each end, for the stage to reach speed (continuous)
-  double settle_s = 0.02;  ///< after a step before a line counts (step-and-scan)
+  bool continuous = true;        ///< false: step-and-scan (the paper's)
+  double theta_min_deg = -45.0;  ///< the sweep covers theta_min_deg <= theta < theta_max_deg
+  double theta_max_deg = 45.0;
+  double theta_step_deg = 0.45;  ///< one scan line per step
+  double margin_deg = 0.5;       ///< past each end, for the stage to reach speed (continuous)
+  double settle_s = 0.02;        ///< after a step before a line counts (step-and-scan)
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };

@@ -22,7 +22,7 @@ struct IsolationConfig {
   double cell = 0.04;            ///< grid cell of the trunk search
   /// Columns score lower with their distance from the expected trunk position (Gaussian of
   /// this sigma): keeps the search off the trellis posts and the neighbours in the row.
-  double hint_sigma = 0.25;
+  double hint_sigma_m = 0.25;
   /// The columns scoring at least this share of the best (up to max_candidates) are compared
   /// by the branch points around them: in a ring of branch_ring_inner..branch_ring_outer (m)
   /// around the column, branch_ring_low..branch_ring_high (m) above the ground. A trunk has
@@ -31,10 +31,10 @@ struct IsolationConfig {
   std::size_t max_candidates = 30;
   double branch_ring_inner = 0.12, branch_ring_outer = 0.4;
   double branch_ring_low = 0.8, branch_ring_high = 2.5;
-  double min_distance = 0.3;  ///< the trunk lies this far ahead of the sensor at least
-  double max_distance = 4.0;  ///< and at most (the next row is ~3.5 m away)
-  double crop_radius = 0.7;   ///< kept around the trunk axis (neighbours ~0.9-1.2 m away)
-  double max_height = 5.5;    ///< kept up to this height above the ground
+  double min_distance = 0.3;   ///< the trunk lies this far ahead of the sensor at least
+  double max_distance = 4.0;   ///< and at most (the next row is ~3.5 m away)
+  double crop_radius_m = 0.7;  ///< kept around the trunk axis (neighbours ~0.9-1.2 m away)
+  double max_height_m = 5.5;   ///< kept up to this height above the ground
   /// Upright columns (posts, a neighbour's trunk) further than this from the trunk are cut
   /// out over their whole height, within other_column_radius of their cells.
   double trunk_clearance = 0.15;

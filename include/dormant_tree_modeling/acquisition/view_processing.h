@@ -12,10 +12,10 @@ namespace acquisition {
 
 /// @brief From one sweep's range image to the view cloud (docs/algorithms.md, section 1).
 struct ViewProcessingConfig {
-  double floating_threshold = 0.05;  ///< rho_T of Eq. 1, m
-  int smoothing_iterations = 0;      ///< range smoothing passes (0: off; the modeler's
-                                     ///< diameter calibration assumes unsmoothed ranges)
-  double phi_min_deg = 0.0;          ///< beams kept: the tree lies in [0, 180) deg
+  double floating_threshold_m = 0.05;  ///< rho_T of Eq. 1
+  int smoothing_iterations = 0;        ///< range smoothing passes (0: off; the modeler's
+                                       ///< diameter calibration assumes unsmoothed ranges)
+  double phi_min_deg = 0.0;            ///< beams kept: the tree lies in [0, 180) deg
   double phi_max_deg = 180.0;
   bool isolate = true;  ///< cut the target tree out (else the whole view)
   IsolationConfig isolation;

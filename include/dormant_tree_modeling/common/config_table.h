@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
 #include <functional>
 #include <string>
 #include <type_traits>
@@ -29,6 +30,7 @@ std::string formatValue(bool v);
 std::string formatValue(const std::string& v);
 std::string formatValue(const std::vector<double>& v);
 std::string formatValue(const std::vector<std::string>& v);
+std::string formatValue(const Eigen::Vector3d& v);
 template <typename T>
 std::enable_if_t<std::is_integral_v<T> && !std::is_same_v<T, bool>, std::string> formatValue(T v) {
   return std::to_string(v);
@@ -79,6 +81,13 @@ class ConfigTable {
     f.problem = [get, lo, hi, key, what](const Config& c) {
       if constexpr (std::is_arithmetic_v<T>) {
         return config_detail::outsideMessage(what, key, static_cast<double>(get(c)), lo, hi);
+      } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+        for (int i = 0; i < 3; ++i) {
+          const std::string m = config_detail::outsideMessage(what, key, get(c)[i], lo, hi);
+          if (!m.empty())
+            return m;
+        }
+        return std::string();
       } else {
         if (get(c).empty())
           return what + " " + key + " must not be empty";
@@ -134,7 +143,8 @@ class ConfigTable {
   template <typename Owner, typename E>
   ConfigTable& names(const std::string& key, E Owner::*member,
                      const std::vector<std::pair<std::string, E>>& values, const std::string& doc) {
-    static_assert(std::is_enum_v<E>, "names() is for enumerations");
+    static_assert(std::is_enum_v<E> || std::is_same_v<E, bool>,
+                  "names() is for enumerations and two-way choices");
     Field f;
     f.info.key = key;
     f.info.doc = doc;
@@ -267,6 +277,13 @@ class ConfigTable {
     }
   }
 
+  /// @brief A check between fields that no range expresses.
+  /// @throws Error INVALID_ARGUMENT "<what> <message>" unless ok
+  void require(bool ok, const std::string& message) const {
+    if (!ok)
+      throw Error(ErrorCode::INVALID_ARGUMENT, what_ + " " + message);
+  }
+
   bool has(const std::string& key) const {
     for (const auto& f : fields_) {
       if (f.info.key == key)
@@ -361,6 +378,8 @@ class ConfigTable {
       return "a number";
     else if constexpr (std::is_same_v<T, std::string>)
       return "a string";
+    else if constexpr (std::is_same_v<T, Eigen::Vector3d>)
+      return "a list [x, y, z]";
     else
       return "a list";
   }
@@ -382,3 +401,17 @@ class ConfigTable {
 };
 
 }  // namespace dormant_tree_modeling
+
+namespace YAML {
+/// A 3-vector as a YAML list [x, y, z] (mounting offsets).
+template <>
+struct convert<Eigen::Vector3d> {
+  static bool decode(const Node& node, Eigen::Vector3d& v) {
+    if (!node.IsSequence() || node.size() != 3)
+      return false;
+    for (std::size_t i = 0; i < 3; ++i)
+      v[static_cast<Eigen::Index>(i)] = node[i].as<double>();
+    return true;
+  }
+};
+}  // namespace YAML

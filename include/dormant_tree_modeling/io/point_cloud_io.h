@@ -8,6 +8,10 @@
 #include "dormant_tree_modeling/common/cloud.h"
 
 namespace dormant_tree_modeling {
+
+template <typename Config>
+class ConfigTable;
+
 namespace io {
 
 /// @brief Point cloud file formats the project reads and writes.
@@ -60,6 +64,18 @@ std::vector<Eigen::Vector3d> readPointsInFileFrame(const std::string& path);
 /// @throws Error UNKNOWN_FORMAT, IO_FAILURE
 void writeCloud(const std::string& path, const Cloud& cloud,
                 const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
+
+/// @brief The cloud file publisher node's parameters (launch/model_file.launch).
+struct CloudPublisherConfig {
+  std::string file;                  ///< .pcd, .ply or .xyz; required
+  std::string frame_id = "orchard";  ///< frame of the published cloud
+  double rate_hz = 0.0;              ///< republish rate; 0: once, latched
+  /// @throws Error INVALID_ARGUMENT naming the field
+  void validate() const;
+};
+
+/// @brief The keys of the cloud file publisher node: its parameters, docs/configuration.md.
+const ConfigTable<CloudPublisherConfig>& cloudPublisherConfigTable();
 
 }  // namespace io
 }  // namespace dormant_tree_modeling

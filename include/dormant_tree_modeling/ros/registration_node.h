@@ -17,6 +17,7 @@
 
 #include "dormant_tree_modeling/common/cloud.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
+#include "dormant_tree_modeling/registration/node_config.h"
 #include "dormant_tree_modeling/registration/stations.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
@@ -58,6 +59,9 @@ class RegistrationNode {
  public:
   /// @throws Error when the configuration cannot be loaded
   RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  /// @brief With the node's parameters already read.
+  RegistrationNode(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+                   const registration::RegistrationNodeConfig& node);
   ~RegistrationNode();
   RegistrationNode(const RegistrationNode&) = delete;
   RegistrationNode& operator=(const RegistrationNode&) = delete;

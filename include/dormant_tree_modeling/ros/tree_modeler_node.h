@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "dormant_tree_modeling/modeling/node_config.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
@@ -40,6 +41,9 @@ class TreeModelerNode {
  public:
   /// @throws Error when the configuration cannot be loaded
   TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  /// @brief With the node's parameters already read.
+  TreeModelerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+                  const modeling::TreeModelerNodeConfig& node);
   ~TreeModelerNode();
   TreeModelerNode(const TreeModelerNode&) = delete;
   TreeModelerNode& operator=(const TreeModelerNode&) = delete;

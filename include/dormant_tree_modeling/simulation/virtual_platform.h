@@ -4,13 +4,19 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
+#include "dormant_tree_modeling/aerotech/stage_config.h"
 #include "dormant_tree_modeling/emulation/ensemble_server.h"
 #include "dormant_tree_modeling/emulation/lms111_server.h"
 #include "dormant_tree_modeling/geometry/stage_kinematics.h"
 #include "dormant_tree_modeling/simulation/scene.h"
 
 namespace dormant_tree_modeling {
+
+template <typename Config>
+class ConfigTable;
+
 namespace simulation {
 
 /// @brief The scanning platform without hardware (architecture.md `virtual_platform`).
@@ -23,15 +29,39 @@ struct VirtualPlatformConfig {
   /// The platform in the scene frame (platformPose); default: 1.5 m in front of the target
   /// tree, facing it, the laser at 1.5 m.
   Eigen::Isometry3d platform = geometry::platformPose(0.0, -1.5, 1.5, M_PI / 2);
-  /// Mounting, as config/stage_controller.yaml: the platform frame at the slide's centre.
-  geometry::StageGeometry geometry = [] {
-    geometry::StageGeometry g;
-    g.platform_to_slide_base = Eigen::Vector3d(0.0, -0.3, 0.0);
-    return g;
-  }();
+  /// Mounting: the stage controller's default (config/stage_controller.yaml).
+  geometry::StageGeometry geometry = aerotech::StageConfig().geometry;
   emulation::EnsembleFaults stage_faults;
   emulation::LmsFaults laser_faults;
 };
+
+/// @brief The virtual platform node's parameters (launch/virtual_platform.launch).
+struct VirtualPlatformNodeConfig {
+  int lms_port = 2111;              ///< the emulated LMS111's CoLa-A port; 0: any, -1: off
+  int lms_b_port = 2112;            ///< CoLa-B
+  int aerotech_port = 8000;         ///< the emulated Ensemble
+  double scan_frequency_hz = 25.0;  ///< the LMS111's power-up frequency (25 or 50)
+  double noise_mm = 12.0;           ///< range noise, 1 sigma
+  int seed = 1;
+  std::vector<double> platform = {0.0, -1.5, 1.5, 90.0};  ///< start: x, y, z (m), yaw (deg)
+  std::string fault_axis;  ///< the emulated stage fails moves of this axis ...
+  int fault_on_move = 0;   ///< ... from this move on (0: never)
+  std::string scene_frame = "orchard";
+  std::string output_dir;  ///< scene.json and truth.json; empty: none
+  std::string in_place_service = "/acquisition/platform_in_place";
+  double placement_error_m = 0.2;  ///< the virtual operator's error after the first position
+  double placement_error_yaw_deg = 8.0;
+  double settle_time_s = 0.5;  ///< after a move before the platform reports it is in place
+  std::string scene_file;      ///< a scene.json; empty: the preset
+  std::string preset = "young_tall_spindle";
+  bool follow_goals = false;  ///< drive to the acquisition's platform goals
+  std::string goal_topic = "/acquisition/platform_goal";
+  /// @throws Error INVALID_ARGUMENT naming the field
+  void validate() const;
+};
+
+/// @brief The keys of the virtual platform node: its parameters, docs/configuration.md.
+const ConfigTable<VirtualPlatformNodeConfig>& virtualPlatformNodeConfigTable();
 
 /// @brief Serves an LMS111 and an Aerotech Ensemble (rotary stage X in deg, 600 mm slide Y in
 /// mm) on loopback from one scene: each simulated scan line is taken from the pose the
