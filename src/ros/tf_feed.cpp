@@ -1,5 +1,7 @@
 #include "dormant_tree_modeling/ros/tf_feed.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <ros/rate.h>
 
 namespace dormant_tree_modeling {
@@ -37,7 +39,24 @@ void TfFeed::add(const tf2_msgs::TFMessage& msg, const std::string& authority, b
 }
 
 bool frameKnown(const tf2_ros::Buffer& buffer, const std::string& frame) {
-  return buffer._frameExists(frame);
+  YAML::Node frames;
+  try {
+    frames = YAML::Load(buffer.allFramesAsYAML());
+  } catch (const YAML::Exception& e) {
+    ROS_WARN_THROTTLE(10.0, "tf frames not readable (%s): treating '%s' as unknown", e.what(),
+                      frame.c_str());
+    return false;
+  }
+  if (!frames.IsMap())
+    return false;  // no transform yet ("[]")
+  for (const auto& entry : frames) {
+    if (entry.first.as<std::string>() == frame)
+      return true;
+    const YAML::Node parent = entry.second["parent"];
+    if (parent && parent.as<std::string>() == frame)
+      return true;
+  }
+  return false;
 }
 
 geometry_msgs::TransformStamped lookupWithin(const tf2_ros::Buffer& buffer,

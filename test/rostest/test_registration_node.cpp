@@ -9,6 +9,7 @@
 #include <std_msgs/String.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <pcl/point_cloud.h>
@@ -22,6 +23,7 @@
 #include "dormant_tree_modeling/registration/view_folder.h"
 #include "dormant_tree_modeling/ros/conversions.h"
 #include "dormant_tree_modeling/ros/registration_node.h"
+#include "dormant_tree_modeling/ros/tf_feed.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
 
 namespace {
@@ -231,6 +233,25 @@ TEST(PlanEnd, ReadsTheTypedProgressAndTheTextOfOlderBags) {
   std_msgs::Int32 other;
   shapeOf(other, shape);
   EXPECT_FALSE(ros_layer::planEnd(shape)) << "another type is no plan's end";
+}
+
+TEST(FrameKnown, NamesEveryFrameOfTheTreeRootsIncludedAndNothingElse) {
+  tf2_ros::Buffer buffer;
+  EXPECT_FALSE(ros_layer::frameKnown(buffer, "orchard")) << "an empty buffer knows no frame";
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time(10.0);
+  t.header.frame_id = "orchard";
+  t.child_frame_id = "platform";
+  t.transform.rotation.w = 1.0;
+  buffer.setTransform(t, "test", true);
+  t.header.frame_id = "platform";
+  t.child_frame_id = "laser";
+  buffer.setTransform(t, "test", false);
+  EXPECT_TRUE(ros_layer::frameKnown(buffer, "orchard")) << "the root: only ever a parent";
+  EXPECT_TRUE(ros_layer::frameKnown(buffer, "platform"));
+  EXPECT_TRUE(ros_layer::frameKnown(buffer, "laser"));
+  EXPECT_FALSE(ros_layer::frameKnown(buffer, "tree"));
+  EXPECT_FALSE(ros_layer::frameKnown(buffer, "las"));
 }
 
 }  // namespace

@@ -41,8 +41,9 @@ class TfFeed {
 };
 
 /// @brief Whether the buffer has heard of `frame` at all, so that a lookup that can never
-/// succeed is not waited for. The one place the nodes use tf2's underscored `_frameExists`:
-/// tf2 has no public existence query, and `canTransform(f, f)` answers true for any name.
+/// succeed is not waited for. tf2's only existence query is the underscored `_frameExists`,
+/// and `canTransform(f, f)` answers true for any name, so this reads the public frame list
+/// (`allFramesAsYAML`: each frame with a parent as a key, a root frame as a parent).
 bool frameKnown(const tf2_ros::Buffer& buffer, const std::string& frame);
 
 /// @brief tf lookup that waits for the transform in wall time.
