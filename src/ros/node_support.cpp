@@ -37,28 +37,20 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
   }
 }
 
-void checkParameterNames(const ros::NodeHandle& pnh, const std::vector<FieldInfo>& fields,
-                         const std::vector<std::string>& others) {
+std::vector<std::pair<std::string, std::string>> privateParameters(const ros::NodeHandle& pnh) {
   std::vector<std::string> names;
+  std::vector<std::pair<std::string, std::string>> out;
   if (!ros::param::getParamNames(names))
-    return;  // no master to ask: the reads below fail on their own
+    return out;  // no master: nothing set, the defaults stand
   const std::string ns = pnh.getNamespace() + "/";
   for (const auto& full : names) {
     if (full.rfind(ns, 0) != 0)
       continue;
     std::string key = full.substr(ns.size());
     std::replace(key.begin(), key.end(), '/', '.');
-    const auto field = std::find_if(fields.begin(), fields.end(), [&key](const FieldInfo& f) {
-      return f.key == key || f.former_key == key;
-    });
-    if (field != fields.end() && field->key != key) {
-      std::string now = field->key;
-      std::replace(now.begin(), now.end(), '.', '/');
-      throw Error(ErrorCode::PARSE_ERROR, "parameter " + full + " is now " + ns + now);
-    }
-    if (field == fields.end() && std::find(others.begin(), others.end(), key) == others.end())
-      ROS_WARN("unknown parameter %s: not used (see docs/configuration.md)", full.c_str());
+    out.emplace_back(full, key);
   }
+  return out;
 }
 
 }  // namespace ros_layer

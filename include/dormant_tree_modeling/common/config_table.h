@@ -81,17 +81,12 @@ class ConfigTable {
     f.problem = [get, lo, hi, key, what](const Config& c) {
       if constexpr (std::is_arithmetic_v<T>) {
         return config_detail::outsideMessage(what, key, static_cast<double>(get(c)), lo, hi);
-      } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
-        for (int i = 0; i < 3; ++i) {
-          const std::string m = config_detail::outsideMessage(what, key, get(c)[i], lo, hi);
-          if (!m.empty())
-            return m;
-        }
-        return std::string();
       } else {
-        if (get(c).empty())
-          return what + " " + key + " must not be empty";
-        for (const auto v : get(c)) {
+        if constexpr (!std::is_same_v<T, Eigen::Vector3d>) {
+          if (get(c).empty())
+            return what + " " + key + " must not be empty";
+        }
+        for (const double v : get(c)) {
           const std::string m = config_detail::outsideMessage(what, key, v, lo, hi);
           if (!m.empty())
             return m;
@@ -110,29 +105,8 @@ class ConfigTable {
     return *this;
   }
 
-  /// @brief A string that must be one of `choices`.
-  template <typename Owner>
-  ConfigTable& choice(const std::string& key, std::string Owner::*member,
-                      const std::vector<std::string>& choices, const std::string& doc) {
-    Field f = plain(key, member, doc);
-    std::string text;
-    for (const auto& c : choices)
-      text += (text.empty() ? "" : " | ") + c;
-    f.info.range = text;
-    const auto get = getter<Owner, std::string>(member);
-    const std::string what = what_;
-    f.problem = [get, choices, key, what, text](const Config& c) {
-      for (const auto& v : choices) {
-        if (get(c) == v)
-          return std::string();
-      }
-      return what + " " + key + " = '" + get(c) + "' is not one of " + text;
-    };
-    fields_.push_back(std::move(f));
-    return *this;
-  }
-
-  /// @brief Fields of a nested struct: `group(&Config::trunk, "trunk")` before adding them.
+  /// @brief The fields added next live in this nested struct (`group(&Config::trunk)`); their
+  /// keys name the group themselves ("trunk.slice_height_m").
   template <typename Group>
   ConfigTable& group(Group Config::*member) {
     group_ = [member](Config& c) -> void* { return &(c.*member); };
@@ -185,8 +159,6 @@ class ConfigTable {
       Field g;
       g.info = f.info;
       g.info.key = prefix.empty() ? f.info.key : prefix + "." + f.info.key;
-      if (!f.info.former_key.empty())
-        g.info.former_key = f.info.former_key;
       g.type = f.type;
       g.read = [member, r = f.read](Config& c, const YAML::Node& n) { r(c.*member, n); };
       g.show = [member, s = f.show](const Config& c) { return s(c.*member); };
@@ -240,11 +212,18 @@ class ConfigTable {
         throw Error(e.code(), origin + ": " + e.what());
       } catch (const YAML::Exception&) {
         throw Error(ErrorCode::PARSE_ERROR, origin + ": " + what_ + " '" + key +
-                                                "' has the wrong type (expected " + typeOf(f) +
-                                                ")");
+                                                "' has the wrong type (expected " + f.type + ")");
       }
       return;
     }
+    refuseStaleKey(key, origin);
+    throw Error(ErrorCode::PARSE_ERROR, origin + ": unknown " + what_ + " '" + key + "'");
+  }
+
+  /// @brief For a key that is no field: an error naming the new key of a renamed one, or where
+  /// a retired one's setting lives now; nothing for a key never known.
+  /// @throws Error PARSE_ERROR
+  void refuseStaleKey(const std::string& key, const std::string& origin) const {
     for (const auto& f : fields_) {
       if (!f.info.former_key.empty() && f.info.former_key == key) {
         throw Error(ErrorCode::PARSE_ERROR,
@@ -257,7 +236,6 @@ class ConfigTable {
         throw Error(ErrorCode::PARSE_ERROR,
                     origin + ": '" + key + "' is no longer a " + what_ + ": " + why);
     }
-    throw Error(ErrorCode::PARSE_ERROR, origin + ": unknown " + what_ + " '" + key + "'");
   }
 
   /// @brief Set the fields a YAML file names (nested maps are groups); the rest keep their value.
@@ -284,6 +262,7 @@ class ConfigTable {
       throw Error(ErrorCode::INVALID_ARGUMENT, what_ + " " + message);
   }
 
+  /// @brief Whether `key` is one of the table's fields.
   bool has(const std::string& key) const {
     for (const auto& f : fields_) {
       if (f.info.key == key)
@@ -291,23 +270,7 @@ class ConfigTable {
     }
     return false;
   }
-  std::vector<FieldInfo> fields() const {
-    std::vector<FieldInfo> out;
-    for (const auto& f : fields_)
-      out.push_back(f.info);
-    return out;
-  }
   const std::string& what() const { return what_; }
-  const std::string& section() const { return section_; }
-
-  /// @brief The value of one field as YAML text.
-  std::string valueText(const std::string& key, const Config& c) const {
-    for (const auto& f : fields_) {
-      if (f.info.key == key)
-        return f.show(c);
-    }
-    throw Error(ErrorCode::INVALID_ARGUMENT, "no " + what_ + " '" + key + "'");
-  }
 
   /// @brief The config as a YAML file this table loads, each key with its doc as a comment.
   std::string yaml(const Config& c, const std::string& header) const {
@@ -383,7 +346,6 @@ class ConfigTable {
     else
       return "a list";
   }
-  static std::string typeOf(const Field& f) { return f.type; }
 
   std::vector<std::pair<FieldInfo, std::string>> shown(const Config& c) const {
     std::vector<std::pair<FieldInfo, std::string>> out;

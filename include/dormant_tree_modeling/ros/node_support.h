@@ -39,27 +39,28 @@ class NodeDiagnostics {
 /// @throws Error PARSE_ERROR for a struct, a date or binary data
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 
-/// @brief Stops with the new name when a renamed parameter is still set; warns once per
-/// private parameter that neither the table nor `others` knows (a misspelt parameter would
-/// otherwise be ignored without a word).
-void checkParameterNames(const ros::NodeHandle& pnh, const std::vector<FieldInfo>& fields,
-                         const std::vector<std::string>& others);
+/// @brief The node's private parameters on the server: each leaf's full name and its key in a
+/// field table (groups, the namespaces below the node's, joined by '.'). Empty without a master.
+std::vector<std::pair<std::string, std::string>> privateParameters(const ros::NodeHandle& pnh);
 
-/// @brief A node's parameters through the same table as its YAML file: each key (groups as
-/// `group/key`) read from the private namespace when set, else the default in `config`.
-/// @param others private parameters the node reads outside the table
-/// @throws Error PARSE_ERROR for a value of the wrong type or a renamed key; does not validate
+/// @brief A node's parameters through the same table as its YAML file: each private parameter
+/// that is a key of the table is read (groups as `group/key`), the rest of `config` keeps its
+/// defaults. A parameter still set under a renamed or retired name stops the node with where
+/// it went; one the table does not know is warned of (a misspelt name would otherwise be
+/// ignored without a word).
+/// @throws Error PARSE_ERROR for a value of the wrong type or a stale name; does not validate
 template <typename Config>
 Config readParameters(const ros::NodeHandle& pnh, const ConfigTable<Config>& table,
-                      Config config = Config{}, const std::vector<std::string>& others = {}) {
-  checkParameterNames(pnh, table.fields(), others);
-  for (const auto& field : table.fields()) {
-    std::string name = field.key;
-    for (auto& ch : name)
-      ch = ch == '.' ? '/' : ch;
+                      Config config = Config{}) {
+  for (const auto& [name, key] : privateParameters(pnh)) {
+    const std::string origin = "parameter " + name;
     XmlRpc::XmlRpcValue value;
-    if (pnh.getParam(name, value))
-      table.set(field.key, toYaml(value), config, "parameter " + pnh.resolveName(name));
+    if (!table.has(key)) {
+      table.refuseStaleKey(key, origin);
+      ROS_WARN("unknown parameter %s: not used (see docs/configuration.md)", name.c_str());
+    } else if (ros::param::get(name, value)) {
+      table.set(key, toYaml(value), config, origin);
+    }
   }
   return config;
 }
