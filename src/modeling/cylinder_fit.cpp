@@ -259,6 +259,9 @@ constexpr int MIN_THIN_POINTS = 6;
 constexpr double MIN_THIN_RADIUS_M = 0.002;
 // Robust re-centring works on slices of this length (m) along the axis.
 constexpr double THIN_SLICE_M = 0.04;
+// A parabola through the slice centroids needs three; a fourth keeps it from passing through
+// every centroid's own scatter.
+constexpr std::size_t MIN_BENT_SLICES = 4;
 
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
@@ -351,6 +354,57 @@ std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
   return used;
 }
 
+/// A branch's axis as a parabola along the fitted line: the offset across it as a quadratic
+/// in the position along it, fitted to the slices' centroids. A branch bends by a few degrees
+/// per slice; over a fit's length the straight line leaves its centre by millimetres, which a
+/// radius from second moments would take for thickness.
+class BentAxis {
+ public:
+  BentAxis(const Points& pts, const std::vector<int>& used, const Cylinder& cyl) : cyl_(cyl) {
+    u_ = cyl.axis.unitOrthogonal();
+    v_ = cyl.axis.cross(u_);
+    std::map<long, std::pair<Eigen::Vector3d, int>> sums;
+    for (const int i : used) {
+      const Eigen::Vector3d w = pts[i] - cyl.center;
+      auto it = sums.try_emplace(thinSlice(cyl, pts[i]), Eigen::Vector3d::Zero(), 0).first;
+      it->second.first += Eigen::Vector3d(w.dot(cyl.axis), w.dot(u_), w.dot(v_));
+      ++it->second.second;
+    }
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& kv : sums) {
+      if (kv.second.second >= MIN_THIN_POINTS)
+        centres.push_back(kv.second.first / kv.second.second);
+    }
+    if (centres.size() < MIN_BENT_SLICES)
+      return;
+    Eigen::MatrixXd a(centres.size(), 3);
+    Eigen::MatrixXd b(centres.size(), 2);
+    for (std::size_t k = 0; k < centres.size(); ++k) {
+      const double t = centres[k].x();
+      a.row(k) << 1.0, t, t * t;
+      b.row(k) << centres[k].y(), centres[k].z();
+    }
+    coef_ = a.colPivHouseholderQr().solve(b);
+    bent_ = true;
+  }
+  /// The distance of p from the bent axis (from the straight one with too few slices).
+  double distance(const Eigen::Vector3d& p) const {
+    if (!bent_)
+      return axisDistance(cyl_, p);
+    const Eigen::Vector3d w = p - cyl_.center;
+    const double t = w.dot(cyl_.axis);
+    const Eigen::Vector3d basis(1.0, t, t * t);
+    const Eigen::Vector2d off = coef_.transpose() * basis;
+    return Eigen::Vector2d(w.dot(u_) - off.x(), w.dot(v_) - off.y()).norm();
+  }
+
+ private:
+  const Cylinder& cyl_;
+  Eigen::Vector3d u_, v_;
+  Eigen::Matrix<double, 3, 2> coef_ = Eigen::Matrix<double, 3, 2>::Zero();
+  bool bent_ = false;
+};
+
 /// The median over slices (of at least MIN_THIN_POINTS) of the mean squared distance from the
 /// axis within `reach`, or of all points when no slice has enough; nullopt with fewer than
 /// MIN_THIN_POINTS. Without a scatter to remove (a raw moment, for a calibration) each slice's
@@ -359,8 +413,9 @@ std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
 std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& used,
                                   const Cylinder& cyl, double reach, double scatter) {
   std::map<long, std::vector<double>> sq_by_slice;
+  const BentAxis bent(pts, used, cyl);
   for (const int i : used) {
-    const double dist = axisDistance(cyl, pts[i]);
+    const double dist = bent.distance(pts[i]);
     if (dist < reach)
       sq_by_slice[thinSlice(cyl, pts[i])].push_back(dist * dist);
   }
@@ -415,8 +470,8 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     return std::nullopt;
   // Robust re-centring: per slice the centroid of the points within radius + 2.5 sigma of the
   // current axis, a line through the slice centroids, the radius from the median of the
-  // slices' second moments less the noise. A parallel shoot or a spur moves a least-squares
-  // cylinder, not this.
+  // slices' second moments about the axis bent through those centroids, less the noise. A parallel
+  // shoot or a spur moves a least-squares cylinder, not this.
   std::vector<int> used;
   double radius = max_radius;
   for (int round = 0; round < 5; ++round) {
