@@ -262,6 +262,11 @@ constexpr double THIN_SLICE_M = 0.04;
 // A parabola through the slice centroids needs three; a fourth keeps it from passing through
 // every centroid's own scatter.
 constexpr std::size_t MIN_BENT_SLICES = 4;
+// A branch this many noise sigmas thick shows its arc: its centre comes from a circle fit to
+// its cross-sections, which a one-sided view does not pull, if that circle's radius is within
+// this factor of the moment's.
+constexpr double ARC_MIN_SIGMAS = 2.0;
+constexpr double ARC_RADIUS_SHARE = 2.0;
 
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
@@ -385,24 +390,37 @@ class BentAxis {
       b.row(k) << centres[k].y(), centres[k].z();
     }
     coef_ = a.colPivHouseholderQr().solve(b);
-    bent_ = true;
   }
   /// The distance of p from the bent axis (from the straight one with too few slices).
-  double distance(const Eigen::Vector3d& p) const {
-    if (!bent_)
-      return axisDistance(cyl_, p);
-    const Eigen::Vector3d w = p - cyl_.center;
-    const double t = w.dot(cyl_.axis);
-    const Eigen::Vector3d basis(1.0, t, t * t);
-    const Eigen::Vector2d off = coef_.transpose() * basis;
-    return Eigen::Vector2d(w.dot(u_) - off.x(), w.dot(v_) - off.y()).norm();
+  double distance(const Eigen::Vector3d& p) const { return across(p).norm(); }
+
+  /// Moves the axis onto the centre of the circle the points' cross-sections (bend taken out)
+  /// lie on, when that circle's radius is within ARC_RADIUS_SHARE of `radius`. A thick branch
+  /// seen from one side has its slice centroids on that side: a moment about them reads it thin.
+  void centreOnArc(const Points& pts, const std::vector<int>& used, double radius) {
+    Points2 section;
+    for (const int i : used)
+      section.push_back(across(pts[i]));
+    const auto circle = fitCircle(section);
+    if (circle && circle->radius > radius / ARC_RADIUS_SHARE &&
+        circle->radius < radius * ARC_RADIUS_SHARE && circle->center.norm() < radius)
+      shift_ = circle->center;
   }
 
  private:
+  /// p's offset across the axis from it, in the (u, v) plane.
+  Eigen::Vector2d across(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d w = p - cyl_.center;
+    const double t = w.dot(cyl_.axis);
+    const Eigen::Vector3d basis(1.0, t, t * t);
+    const Eigen::Vector2d off = coef_.transpose() * basis + shift_;
+    return Eigen::Vector2d(w.dot(u_), w.dot(v_)) - off;
+  }
+
   const Cylinder& cyl_;
   Eigen::Vector3d u_, v_;
   Eigen::Matrix<double, 3, 2> coef_ = Eigen::Matrix<double, 3, 2>::Zero();
-  bool bent_ = false;
+  Eigen::Vector2d shift_ = Eigen::Vector2d::Zero();
 };
 
 /// The median over slices (of at least MIN_THIN_POINTS) of the mean squared distance from the
@@ -411,9 +429,9 @@ class BentAxis {
 /// farthest fifth is left out: spurs and shoots on the branch. The calibration absorbs what the
 /// trimming takes from the scatter.
 std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& used,
-                                  const Cylinder& cyl, double reach, double scatter) {
+                                  const Cylinder& cyl, const BentAxis& bent, double reach,
+                                  double scatter) {
   std::map<long, std::vector<double>> sq_by_slice;
-  const BentAxis bent(pts, used, cyl);
   for (const int i : used) {
     const double dist = bent.distance(pts[i]);
     if (dist < reach)
@@ -480,7 +498,13 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
     used = recentre(pts, best, axis_guess, reach, &cyl);
     if (used.empty())
       return std::nullopt;
-    const auto moment = sliceMoment(pts, used, cyl, reach, scatter);
+    BentAxis bent(pts, used, cyl);
+    // A raw radius still carries the noise.
+    const double wood =
+        scatter > 0.0 ? radius : std::sqrt(std::max(0.0, radius * radius - sigma * sigma));
+    if (round > 0 && wood >= ARC_MIN_SIGMAS * std::max(sigma, scatter))
+      bent.centreOnArc(pts, used, radius);
+    const auto moment = sliceMoment(pts, used, cyl, bent, reach, scatter);
     if (!moment)
       return std::nullopt;
     // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
