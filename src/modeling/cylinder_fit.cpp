@@ -365,14 +365,14 @@ std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
 /// radius from second moments would take for thickness.
 class BentAxis {
  public:
-  BentAxis(const Points& pts, const std::vector<int>& used, const Cylinder& cyl) : cyl_(cyl) {
-    u_ = cyl.axis.unitOrthogonal();
-    v_ = cyl.axis.cross(u_);
+  BentAxis(const Points& pts, const std::vector<int>& used, const Cylinder& cyl)
+      : centre_(cyl.center), axis_(cyl.axis) {
+    basis(axis_, u_, v_);
     std::map<long, std::pair<Eigen::Vector3d, int>> sums;
     for (const int i : used) {
-      const Eigen::Vector3d w = pts[i] - cyl.center;
+      const Eigen::Vector3d w = pts[i] - centre_;
       auto it = sums.try_emplace(thinSlice(cyl, pts[i]), Eigen::Vector3d::Zero(), 0).first;
-      it->second.first += Eigen::Vector3d(w.dot(cyl.axis), w.dot(u_), w.dot(v_));
+      it->second.first += Eigen::Vector3d(w.dot(axis_), w.dot(u_), w.dot(v_));
       ++it->second.second;
     }
     std::vector<Eigen::Vector3d> centres;
@@ -410,15 +410,15 @@ class BentAxis {
  private:
   /// p's offset across the axis from it, in the (u, v) plane.
   Eigen::Vector2d across(const Eigen::Vector3d& p) const {
-    const Eigen::Vector3d w = p - cyl_.center;
-    const double t = w.dot(cyl_.axis);
+    const Eigen::Vector3d w = p - centre_;
+    const double t = w.dot(axis_);
     const Eigen::Vector3d basis(1.0, t, t * t);
     const Eigen::Vector2d off = coef_.transpose() * basis + shift_;
     return Eigen::Vector2d(w.dot(u_), w.dot(v_)) - off;
   }
 
-  const Cylinder& cyl_;
-  Eigen::Vector3d u_, v_;
+  // The straight axis the bend is measured from, by value: the fit moves its cylinder on.
+  Eigen::Vector3d centre_, axis_, u_, v_;
   Eigen::Matrix<double, 3, 2> coef_ = Eigen::Matrix<double, 3, 2>::Zero();
   Eigen::Vector2d shift_ = Eigen::Vector2d::Zero();
 };

@@ -106,10 +106,11 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
                             double min_radius);
 
 /// @brief Cylinder for thin, noisy branches, where a RANSAC circle band would be wider than the
-/// radius: a RANSAC line (band: max_radius + 2.5 sigma) refined by PCA on its inliers, then a
-/// least-squares cylinder on them when it agrees with the line (within 20 deg, radius within
-/// bounds), and the radius from the scatter-corrected second moment sqrt(mean d^2 - scatter^2),
-/// d measured from the axis bent (a parabola) through the slices' centroids.
+/// radius: a RANSAC line (band: max_radius + 2.5 sigma) refined by PCA on its inliers and moved
+/// onto its slices' centroids, and the radius from the scatter-corrected second moment
+/// sqrt(mean d^2 - scatter^2), d measured from the axis bent (a parabola) through those
+/// centroids; a branch 2 sigmas thicker than the noise is centred on the circle its
+/// cross-sections lie on instead (a one-sided view pulls the centroids towards the scanner).
 /// @param sigma range noise: sets the bands (m)
 /// @param scatter total scatter removed from the moment (noise and beam spread); 0: the raw
 ///        RMS distance from the axis, which may exceed max_radius by the scatter (m)
