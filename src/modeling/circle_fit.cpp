@@ -1,5 +1,6 @@
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
@@ -9,6 +10,38 @@ namespace modeling {
 
 namespace {
 constexpr int HOPE_CHECK = 64;  // points between checks that a RANSAC hypothesis can still win
+constexpr double INFINITY_BAND = std::numeric_limits<double>::infinity();
+constexpr int ROBUST_MIN_POINTS = 6;   // points inside the band a robust circle needs
+constexpr int ROBUST_ITERATIONS = 20;  // reweighting rounds of robustCircle at most
+
+struct GeometricStep {
+  Eigen::Vector3d step = Eigen::Vector3d::Zero();  ///< centre x, y and radius change
+  int used = 0;                                    ///< points with a weight
+};
+
+/// One Gauss-Newton step of the geometric circle fit on the points less `offset`, each point
+/// weighted by Tukey's biweight of its residual over `band` (an infinite band: least squares).
+GeometricStep geometricStep(const Points2& pts, const Eigen::Vector2d& offset, const Circle& c,
+                            double band) {
+  Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+  GeometricStep out;
+  for (const auto& p : pts) {
+    const Eigen::Vector2d q = p - offset - c.center;
+    const double d = q.norm();
+    const double e = d - c.radius;
+    if (d < 1e-12 || !(std::abs(e) < band))
+      continue;
+    const double u = std::isinf(band) ? 0.0 : e / band;
+    const double w = (1.0 - u * u) * (1.0 - u * u);
+    const Eigen::Vector3d J(-q.x() / d, -q.y() / d, -1.0);
+    JtJ += w * J * J.transpose();
+    Jtr += w * J * e;
+    ++out.used;
+  }
+  out.step = JtJ.ldlt().solve(-Jtr);
+  return out;
+}
 }  // namespace
 
 std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
@@ -56,18 +89,7 @@ std::optional<Circle> fitCircle(const Points2& pts) {
   c.radius = std::sqrt(r2);
   // Geometric refinement: minimise sum (|q - c| - r)^2.
   for (int it = 0; it < 20; ++it) {
-    Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
-    for (const auto& p : pts) {
-      const Eigen::Vector2d q = p - mean - c.center;
-      const double d = q.norm();
-      if (d < 1e-12)
-        continue;
-      const Eigen::Vector3d J(-q.x() / d, -q.y() / d, -1.0);
-      JtJ += J * J.transpose();
-      Jtr += J * (d - c.radius);
-    }
-    const Eigen::Vector3d step = JtJ.ldlt().solve(-Jtr);
+    const Eigen::Vector3d step = geometricStep(pts, mean, c, INFINITY_BAND).step;
     if (!step.allFinite())
       break;
     c.center += step.head<2>();
@@ -78,6 +100,24 @@ std::optional<Circle> fitCircle(const Points2& pts) {
   if (!(c.radius > 0.0) || !c.center.allFinite())
     return std::nullopt;
   c.center += mean;
+  return c;
+}
+
+std::optional<Circle> robustCircle(const Points2& pts, const Circle& start, double band) {
+  if (!(band > 0.0) || !start.center.allFinite() || !(start.radius > 0.0))
+    return std::nullopt;
+  Circle c = start;
+  for (int it = 0; it < ROBUST_ITERATIONS; ++it) {
+    const GeometricStep s = geometricStep(pts, Eigen::Vector2d::Zero(), c, band);
+    if (s.used < ROBUST_MIN_POINTS || !s.step.allFinite())
+      return std::nullopt;
+    c.center += s.step.head<2>();
+    c.radius += s.step(2);
+    if (s.step.norm() < 1e-8)
+      break;
+  }
+  if (!(c.radius > 0.0) || !c.center.allFinite())
+    return std::nullopt;
   return c;
 }
 

@@ -24,7 +24,11 @@ constexpr double ZERO_SLOPE = 0.05;  // |d eta_share| below this is a flat eta
 constexpr int MIN_SLICE_POINTS = 12;
 constexpr double MAX_TRUNK_RADIUS = 0.4;
 constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
-constexpr double FIRST_WINDOW = 0.25;  // m around a track's start searched for its first circle
+constexpr double FIRST_WINDOW = 0.25;   // m around a track's start searched for its first circle
+constexpr int TRIMMED_MEAN_ROUNDS = 4;  // re-centrings of a noisy slice's trimmed mean
+// A noisy slice's ring centre replaces its trimmed mean when they lie this many noise sigmas
+// apart: further than the noise moves either, so something beside the trunk pulls the mean.
+constexpr double RING_DISAGREEMENT_SIGMAS = 2.0;
 // Robust sigmas under and over the taper profile a slice may read and stay in its fit: slices
 // through branch bases read wide, never narrow.
 constexpr double TAPER_BELOW = 2.5;
@@ -375,6 +379,66 @@ double TrunkModel::diameterAt(double s) const {
   return 2.0 * cylinders.back().radius;
 }
 
+namespace {
+
+/// Indices of the points within `window` (m) of `centre`.
+std::vector<int> pointsWithin(const Points2& plane, const Eigen::Vector2d& centre, double window) {
+  std::vector<int> out;
+  for (std::size_t k = 0; k < plane.size(); ++k) {
+    if ((plane[k] - centre).norm() < window)
+      out.push_back(static_cast<int>(k));
+  }
+  return out;
+}
+
+/// The trimmed mean of a disc seen from all around, from the predicted centre (the origin):
+/// its centre, and its points (indices into `plane`) within `window` (m) of that centre.
+Eigen::Vector2d trimmedMeanCentre(const Points2& plane, double window, std::vector<int>* inliers) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (int round = 0; round < TRIMMED_MEAN_ROUNDS; ++round) {
+    *inliers = pointsWithin(plane, centre, window);
+    if (inliers->empty())
+      break;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (const int k : *inliers)
+      sum += plane[k];
+    centre = sum / static_cast<double>(inliers->size());
+  }
+  return centre;
+}
+
+/// A track's slice circle when the noise is comparable to the trunk's radius and a RANSAC band
+/// would cover the whole disc (relative to the predicted centre, the origin). The centre is
+/// the disc's trimmed mean, unless a robust circle fit from the prediction, possible while the
+/// band leaves a hole inside the ring, lies more than RING_DISAGREEMENT_SIGMAS away: then
+/// something beside the trunk pulls the mean (a branch leaving at a whorl fills one side of
+/// the disc, and a track following the mean turns onto the branch), and the ring, which only
+/// the points on it pull, is the centre. The radius is the second moment
+/// about the centre, r^2 + sigma^2.
+std::optional<Circle> noisySliceCircle(const Points2& plane, double r, double sigma,
+                                       const CircleRansacConfig& o, std::vector<int>* inliers) {
+  const double window = r + noiseBand(sigma);
+  Eigen::Vector2d centre = trimmedMeanCentre(plane, window, inliers);
+  if (noiseBand(sigma) < r) {
+    const auto ring = robustCircle(plane, Circle{Eigen::Vector2d::Zero(), r}, noiseBand(sigma));
+    if (ring && ring->radius >= o.min_radius && ring->radius <= o.max_radius &&
+        ring->center.norm() < r &&
+        (ring->center - centre).norm() > RING_DISAGREEMENT_SIGMAS * sigma) {
+      centre = ring->center;
+      *inliers = pointsWithin(plane, centre, window);
+    }
+  }
+  if (inliers->empty())
+    return std::nullopt;
+  double m2 = 0.0;
+  for (const int k : *inliers)
+    m2 += (plane[k] - centre).squaredNorm();
+  const double est = std::sqrt(std::max(0.0, m2 / inliers->size() - sigma * sigma));
+  return Circle{centre, std::clamp(est, o.min_radius, o.max_radius)};
+}
+
+}  // namespace
+
 // One climb up the trunk, circle by circle; the state carried between steps (last circle,
 // step, misses) is what keeps it one loop.
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
@@ -416,30 +480,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
       // a small guess (a fragment's arc fit) would settle on a patch of the trunk's flank.
       circle = ransacCircle(plane, o, &inliers);
     } else {
-      // Noise comparable to the radius: a circle band would cover the whole disc. The disc's
-      // trimmed mean is its centre (views all around), its second moment r^2 + sigma^2.
-      Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-      const double window = r + noiseBand(sigma);
-      for (int round = 0; round < 4; ++round) {
-        Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-        inliers.clear();
-        for (std::size_t k = 0; k < plane.size(); ++k) {
-          if ((plane[k] - centre).norm() < window) {
-            sum += plane[k];
-            inliers.push_back(static_cast<int>(k));
-          }
-        }
-        if (inliers.empty())
-          break;
-        centre = sum / static_cast<double>(inliers.size());
-      }
-      double m2 = 0.0;
-      for (const int k : inliers)
-        m2 += (plane[k] - centre).squaredNorm();
-      if (!inliers.empty()) {
-        const double est = std::sqrt(std::max(0.0, m2 / inliers.size() - sigma * sigma));
-        circle = Circle{centre, std::clamp(est, o.min_radius, o.max_radius)};
-      }
+      circle = noisySliceCircle(plane, r, sigma, o, &inliers);
     }
 
     const bool ok = circle && inliers.size() >= MIN_SLICE_POINTS / 2 &&

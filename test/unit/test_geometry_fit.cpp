@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/geometry_fit.h"
@@ -42,6 +43,55 @@ TEST(Circle, LeastSquaresIsExactOnExactPoints) {
   EXPECT_NEAR(c->center.x(), 2.0, 1e-9);
   EXPECT_NEAR(c->center.y(), -1.0, 1e-9);
   EXPECT_NEAR(c->radius, 0.3, 1e-9);
+}
+
+TEST(Circle, RobustFitIsHeldByTheRingNotByABranchBesideIt) {
+  // A trunk's cross-section (r 5 cm, 12 mm radial noise, seen all around) fused with a branch
+  // leaving it: 150 returns of a 3 cm ring 7 cm off. The disc's centroid and the least-squares
+  // circle are dragged towards the branch; the robust fit, started at the trunk's predicted
+  // centre, stays on the trunk.
+  Rng rng(11);
+  const Eigen::Vector2d trunk(0.01, -0.02), branch = trunk + Eigen::Vector2d(0.07, 0.0);
+  const double sigma = 0.012;
+  Points2 pts;
+  for (int i = 0; i < 300; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI), r = 0.05 + rng.normal(0.0, sigma);
+    pts.push_back(trunk + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  for (int i = 0; i < 150; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI), r = 0.03 + rng.normal(0.0, sigma);
+    pts.push_back(branch + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
+  }
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const auto& p : pts)
+    centroid += p;
+  centroid /= static_cast<double>(pts.size());
+  const auto plain = fitCircle(pts);
+  ASSERT_TRUE(plain);
+  const auto robust = robustCircle(pts, Circle{{0.0, 0.0}, 0.05}, 2.5 * sigma);
+  ASSERT_TRUE(robust);
+  std::printf(
+      "[ INFO ] off the trunk's centre: centroid %.1f mm, least squares %.1f mm, "
+      "robust %.1f mm\n",
+      1000 * (centroid - trunk).norm(), 1000 * (plain->center - trunk).norm(),
+      1000 * (robust->center - trunk).norm());
+  EXPECT_GT((centroid - trunk).norm(), 0.015);
+  EXPECT_GT((plain->center - trunk).norm(), 0.010);
+  EXPECT_LT((robust->center - trunk).norm(), 0.4 * (centroid - trunk).norm());
+  EXPECT_LT((robust->center - trunk).norm(), 0.008);
+  EXPECT_NEAR(robust->radius, 0.05, 0.005);
+}
+
+TEST(Circle, RobustFitNeedsPointsInItsBand) {
+  Points2 far;
+  for (int k = 0; k < 7; ++k)
+    far.emplace_back(std::cos(k * M_PI / 4), std::sin(k * M_PI / 4));  // a unit ring
+  EXPECT_FALSE(robustCircle(far, Circle{{0, 0}, 0.05}, 0.01));
+  EXPECT_FALSE(robustCircle(far, Circle{{0, 0}, 1.0}, 0.0));
+  const auto ring = robustCircle(far, Circle{{0.01, 0}, 0.95}, 0.1);
+  ASSERT_TRUE(ring);
+  EXPECT_NEAR(ring->center.norm(), 0.0, 1e-6);
+  EXPECT_NEAR(ring->radius, 1.0, 1e-6);
 }
 
 TEST(Circle, RansacIgnoresOutliersAndRespectsBounds) {

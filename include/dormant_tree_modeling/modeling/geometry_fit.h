@@ -40,6 +40,17 @@ std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vecto
 /// @returns nothing for fewer than 3 points or a degenerate configuration
 std::optional<Circle> fitCircle(const Points2& pts);
 
+/// @brief Geometric circle fit from `start` that only the points near the circle pull: each
+/// point is weighted by Tukey's biweight of its distance from the circle over `band`, and
+/// points further out weigh nothing (iteratively reweighted Gauss-Newton). A branch leaving a
+/// trunk, or anything else beside the circle, does not drag it the way it drags a plain fit
+/// or a centroid.
+/// @param start where the fit starts (centre and radius), e.g. the circle predicted from the
+///        slices below
+/// @param band half-width (m) of the band that holds the circle's points (noiseBand())
+/// @returns nothing when fewer than 6 points lie within the band or the fit degenerates
+std::optional<Circle> robustCircle(const Points2& pts, const Circle& start, double band);
+
 /// @brief Options of ransacCircle().
 struct CircleRansacConfig {
   double threshold = 0.005;  ///< m, inlier band around the circle
