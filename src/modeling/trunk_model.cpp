@@ -26,6 +26,9 @@ constexpr double MAX_TRUNK_RADIUS = 0.4;
 constexpr double TAPER_SWELL = 0.1;  // a trunk segment may be this much thicker than the one below
 constexpr double FIRST_WINDOW = 0.25;   // m around a track's start searched for its first circle
 constexpr int TRIMMED_MEAN_ROUNDS = 4;  // re-centrings of a noisy slice's trimmed mean
+// A slice whose noise sigma exceeds this share of its radius is a disc to a circle band: it
+// is centred on its trimmed mean, not on a RANSAC circle.
+constexpr double NOISY_SLICE_SHARE = 0.2;
 // A noisy slice's ring centre replaces its trimmed mean when they lie this many noise sigmas
 // apart: further than the noise moves either, so something beside the trunk pulls the mean.
 constexpr double RING_DISAGREEMENT_SIGMAS = 2.0;
@@ -45,6 +48,34 @@ struct SliceBounds {
   double max_distance = 1e300;
 };
 
+/// Indices of the points within `window` (m) of `centre`.
+std::vector<int> pointsWithin(const Points2& plane, const Eigen::Vector2d& centre, double window) {
+  std::vector<int> out;
+  for (std::size_t k = 0; k < plane.size(); ++k) {
+    if ((plane[k] - centre).norm() < window)
+      out.push_back(static_cast<int>(k));
+  }
+  return out;
+}
+
+/// The trimmed mean of a disc seen from all around, re-centred TRIMMED_MEAN_ROUNDS times from
+/// `start`: its centre, and its points (indices into `plane`) within `window` (m) of the
+/// centre before the last move.
+Eigen::Vector2d trimmedMeanCentre(const Points2& plane, const Eigen::Vector2d& start, double window,
+                                  std::vector<int>* inliers) {
+  Eigen::Vector2d centre = start;
+  for (int round = 0; round < TRIMMED_MEAN_ROUNDS; ++round) {
+    *inliers = pointsWithin(plane, centre, window);
+    if (inliers->empty())
+      break;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (const int k : *inliers)
+      sum += plane[k];
+    centre = sum / static_cast<double>(inliers->size());
+  }
+  return centre;
+}
+
 }  // namespace
 
 std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const CircleRansacConfig& o,
@@ -53,25 +84,11 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const Circle
   auto circle = ransacCircle(plane, o, &inliers);
   if (!circle)
     return std::nullopt;
-  if (sigmaOfBand(o.threshold) > 0.2 * circle->radius) {
+  if (sigmaOfBand(o.threshold) > NOISY_SLICE_SHARE * circle->radius) {
     // Noise comparable to the radius: the circle band covers the whole disc and its centre
     // drifts towards branch bases; the disc's trimmed mean is the better centre.
-    Eigen::Vector2d centre = circle->center;
-    const double window = circle->radius + o.threshold;
-    for (int round = 0; round < 4; ++round) {
-      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-      int n_in = 0;
-      for (const auto& q : plane) {
-        if ((q - centre).norm() < window) {
-          sum += q;
-          ++n_in;
-        }
-      }
-      if (n_in == 0)
-        break;
-      centre = sum / n_in;
-    }
-    circle->center = centre;
+    std::vector<int> disc;
+    circle->center = trimmedMeanCentre(plane, circle->center, circle->radius + o.threshold, &disc);
   }
   SliceCircle out{*circle, static_cast<int>(inliers.size()), false};
   if (surface) {
@@ -381,32 +398,6 @@ double TrunkModel::diameterAt(double s) const {
 
 namespace {
 
-/// Indices of the points within `window` (m) of `centre`.
-std::vector<int> pointsWithin(const Points2& plane, const Eigen::Vector2d& centre, double window) {
-  std::vector<int> out;
-  for (std::size_t k = 0; k < plane.size(); ++k) {
-    if ((plane[k] - centre).norm() < window)
-      out.push_back(static_cast<int>(k));
-  }
-  return out;
-}
-
-/// The trimmed mean of a disc seen from all around, from the predicted centre (the origin):
-/// its centre, and its points (indices into `plane`) within `window` (m) of that centre.
-Eigen::Vector2d trimmedMeanCentre(const Points2& plane, double window, std::vector<int>* inliers) {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (int round = 0; round < TRIMMED_MEAN_ROUNDS; ++round) {
-    *inliers = pointsWithin(plane, centre, window);
-    if (inliers->empty())
-      break;
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (const int k : *inliers)
-      sum += plane[k];
-    centre = sum / static_cast<double>(inliers->size());
-  }
-  return centre;
-}
-
 /// A track's slice circle when the noise is comparable to the trunk's radius and a RANSAC band
 /// would cover the whole disc (relative to the predicted centre, the origin). The centre is
 /// the disc's trimmed mean, unless a robust circle fit from the prediction, possible while the
@@ -418,7 +409,7 @@ Eigen::Vector2d trimmedMeanCentre(const Points2& plane, double window, std::vect
 std::optional<Circle> noisySliceCircle(const Points2& plane, double r, double sigma,
                                        const CircleRansacConfig& o, std::vector<int>* inliers) {
   const double window = r + noiseBand(sigma);
-  Eigen::Vector2d centre = trimmedMeanCentre(plane, window, inliers);
+  Eigen::Vector2d centre = trimmedMeanCentre(plane, Eigen::Vector2d::Zero(), window, inliers);
   if (noiseBand(sigma) < r) {
     const auto ring = robustCircle(plane, Circle{Eigen::Vector2d::Zero(), r}, noiseBand(sigma));
     if (ring && ring->radius >= o.min_radius && ring->radius <= o.max_radius &&
@@ -475,7 +466,7 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     const double sigma = sigmaOfBand(threshold);
     if (plane.size() < MIN_SLICE_POINTS) {
       // nothing to fit
-    } else if (first || sigma < 0.2 * r) {
+    } else if (first || sigma < NOISY_SLICE_SHARE * r) {
       // The first circle is RANSAC's whatever the guess: the disc below needs the radius, and
       // a small guess (a fragment's arc fit) would settle on a patch of the trunk's flank.
       circle = ransacCircle(plane, o, &inliers);
