@@ -48,6 +48,18 @@ constexpr int MAX_WIRES = 10;
 constexpr int WIRE_HYPOTHESES = 300;         // lines sampled per wire searched
 constexpr std::size_t MIN_WIRE_SUPPORT = 5;  // line-like candidates on a line worth judging
 constexpr double WIRE_TEST_VOXEL = 0.01;     // m
+constexpr int WIRE_REFINE_ROUNDS = 2;        // fits of a sampled line to the points near it
+// Seen along the row, a wire is a spot a few cm across: a grid of WIRE_BAND cells over every
+// WIRE_SPOT_STRIDE-th point, whose WIRE_SPOTS_TRIED densest cells are tried as wires.
+constexpr std::size_t WIRE_SPOT_STRIDE = 4;
+constexpr int WIRE_SPOTS_TRIED = 30;
+// Without a local line to vouch for it, a spot's line is a wire only when returns fill this
+// share of the WIRE_COVER_BIN bins along its longest run: the branches and trunks a line along
+// the row strings together leave gaps.
+constexpr double WIRE_COVER_BIN = 0.02;  // m
+constexpr double WIRE_MIN_COVER = 0.95;
+// The wires of a trellis are decimetres apart: a spot this near a wire's line is its fringe.
+constexpr double WIRE_SEPARATION = 2.0 * WIRE_BAND;
 
 /// Downsamples pts again on coarser grids until at most `cap` are left.
 /// @param voxel the grid pts were downsampled on (m); receives the grid used
@@ -129,18 +141,39 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
   return before - pts.size();
 }
 
-/// Longest run of projections along a line without a gap above WIRE_MAX_GAP.
-double longestRun(std::vector<double>& t) {
+/// Longest run of projections along a line without a gap above WIRE_MAX_GAP; sorts t.
+/// @param from receives the index in t where the run starts (may be null)
+double longestRun(std::vector<double>& t, std::size_t* from = nullptr) {
   if (t.empty())
     return 0.0;
   std::sort(t.begin(), t.end());
-  double best = 0.0, start = t[0];
+  double best = 0.0;
+  std::size_t start = 0, best_start = 0;
   for (std::size_t i = 1; i < t.size(); ++i) {
     if (t[i] - t[i - 1] > WIRE_MAX_GAP)
-      start = t[i];
-    best = std::max(best, t[i] - start);
+      start = i;
+    if (t[i] - t[start] > best) {
+      best = t[i] - t[start];
+      best_start = start;
+    }
   }
+  if (from)
+    *from = best_start;
   return best;
+}
+
+/// The share of WIRE_COVER_BIN bins along the longest run of t that hold a projection.
+double runCover(std::vector<double> t) {
+  std::size_t first = 0;
+  const double run = longestRun(t, &first);
+  if (t.empty())
+    return 0.0;
+  const double start = t[first];
+  const auto bins = static_cast<std::size_t>(run / WIRE_COVER_BIN) + 1;
+  std::vector<char> held(bins, 0);
+  for (std::size_t i = first; i < t.size() && t[i] <= start + run; ++i)
+    held[std::min(bins - 1, static_cast<std::size_t>((t[i] - start) / WIRE_COVER_BIN))] = 1;
+  return static_cast<double>(std::count(held.begin(), held.end(), 1)) / static_cast<double>(bins);
 }
 
 /// Candidates: points whose 10 cm neighbourhood is a thin, near-horizontal line (a noisy wire
@@ -193,9 +226,11 @@ struct WireLine {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
   std::size_t support = 0;
 
-  bool near(const Eigen::Vector3d& p) const {
+  bool near(const Eigen::Vector3d& p) const { return squaredDistance(p) < WIRE_BAND * WIRE_BAND; }
+
+  double squaredDistance(const Eigen::Vector3d& p) const {
     const Eigen::Vector3d w = p - origin;
-    return (w - w.dot(direction) * direction).squaredNorm() < WIRE_BAND * WIRE_BAND;
+    return (w - w.dot(direction) * direction).squaredNorm();
   }
 };
 
@@ -219,9 +254,33 @@ WireLine bestLine(const Points& pts, const std::vector<int>& candidates, Rng& rn
   return best;
 }
 
+/// A line through two sampled noisy returns is a few degrees off its wire, centimetres off it a
+/// metre away, and would leave the wire's far parts behind: the line is fitted to the points
+/// near it, and again to those near the fit.
+WireLine refineLine(const Points& pts, WireLine line) {
+  for (int round = 0; round < WIRE_REFINE_ROUNDS; ++round) {
+    Points near;
+    for (const auto& p : pts) {
+      if (line.near(p))
+        near.push_back(p);
+    }
+    if (near.size() < MIN_WIRE_SUPPORT)
+      break;
+    Eigen::Vector3d centroid;
+    const Eigen::Vector3d direction = principalAxis(near, &centroid);
+    if (std::abs(direction.z()) > std::sin(WIRE_MAX_TILT))
+      break;
+    line.origin = centroid;
+    line.direction = direction;
+  }
+  return line;
+}
+
 /// The points near a line (indices), and the length of their longest run along it without a
 /// gap over WIRE_MAX_GAP.
-std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run) {
+/// @param cover receives the share of the run's bins holding a return (may be null)
+std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run,
+                         double* cover = nullptr) {
   std::vector<double> along;
   std::vector<int> inliers;
   for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -230,6 +289,8 @@ std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run) {
       along.push_back((pts[i] - line.origin).dot(line.direction));
     }
   }
+  if (cover)
+    *cover = runCover(along);
   *run = longestRun(along);
   return inliers;
 }
@@ -248,6 +309,7 @@ void settle(std::vector<int>& candidates, const Points& pts, const WireLine& lin
 struct FoundWire {
   Eigen::Vector3d direction;
   std::vector<int> points;
+  WireLine line;
 };
 
 /// The wires of a row are parallel: the direction most of the lines found share is the row's,
@@ -276,6 +338,109 @@ std::vector<FoundWire> alongTheRow(std::vector<FoundWire> found) {
   return out;
 }
 
+/// The points of the cloud seen along the row: every WIRE_SPOT_STRIDE-th point not on a wire
+/// found, keyed by its WIRE_BAND cell across the row, sorted by key.
+struct AlongTheRow {
+  Eigen::Vector3d along, side, up;
+  std::vector<std::pair<std::int64_t, int>> keyed;
+
+  AlongTheRow(const Points& pts, const Eigen::Vector3d& direction, const std::vector<char>& taken)
+      : along(direction.normalized()),
+        side(Eigen::Vector3d::UnitZ().cross(along).normalized()),
+        up(along.cross(side)) {
+    for (std::size_t i = 0; i < pts.size(); i += WIRE_SPOT_STRIDE) {
+      if (!taken[i])
+        keyed.emplace_back(key(pts[i]), static_cast<int>(i));
+    }
+    std::sort(keyed.begin(), keyed.end());
+  }
+
+  std::int64_t key(const Eigen::Vector3d& p) const {
+    const auto a = static_cast<std::int64_t>(std::floor(p.dot(side) / WIRE_BAND));
+    const auto b = static_cast<std::int64_t>(std::floor(p.dot(up) / WIRE_BAND));
+    return (a << 32) + b;
+  }
+
+  /// The first keyed entry of each cell, the densest cells first.
+  std::vector<std::size_t> densestCells() const {
+    std::vector<std::pair<std::size_t, std::size_t>> cells;  // count, first entry
+    for (std::size_t i = 0; i < keyed.size();) {
+      std::size_t j = i;
+      while (j < keyed.size() && keyed[j].first == keyed[i].first)
+        ++j;
+      cells.emplace_back(j - i, i);
+      i = j;
+    }
+    std::sort(cells.begin(), cells.end(), std::greater<>());
+    std::vector<std::size_t> first;
+    for (const auto& c : cells)
+      first.push_back(c.second);
+    return first;
+  }
+};
+
+/// The line along the row through the centroid of the cell starting at keyed entry `first`.
+WireLine spotLine(const Points& pts, const AlongTheRow& row, std::size_t first) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (std::size_t i = first; i < row.keyed.size() && row.keyed[i].first == row.keyed[first].first;
+       ++i, ++count)
+    sum += pts[row.keyed[i].second];
+  return WireLine{sum / count, row.along, static_cast<std::size_t>(count)};
+}
+
+/// The longest run along a spot's line of the row's sample: a cheap first look, since most
+/// dense spots are a trunk or a branch seen end on.
+double sampleRun(const Points& pts, const AlongTheRow& row, const WireLine& spot) {
+  std::vector<double> along;
+  for (const auto& entry : row.keyed) {
+    const Eigen::Vector3d& p = pts[entry.second];
+    if (spot.near(p))
+      along.push_back((p - spot.origin).dot(spot.direction));
+  }
+  return longestRun(along);
+}
+
+/// Wires the line search missed: branches trained along a wire fill its neighbourhood, and its
+/// returns there are no local line. Seen along the row, every wire is a dense spot: the densest
+/// spots are tried as lines parallel to the wires found, judged as those were.
+void addParallelWires(const Points& pts, double min_length, std::vector<FoundWire>& wires) {
+  std::vector<char> taken(pts.size(), 0);
+  const FoundWire* strongest = &wires.front();
+  for (const auto& w : wires) {
+    for (const int i : w.points)
+      taken[i] = 1;
+    if (w.points.size() > strongest->points.size())
+      strongest = &w;
+  }
+  const AlongTheRow row(pts, strongest->direction, taken);
+  std::vector<WireLine> lines;
+  for (const auto& w : wires)
+    lines.push_back(w.line);
+  int tried = 0;
+  for (const std::size_t first : row.densestCells()) {
+    if (tried >= WIRE_SPOTS_TRIED)
+      break;
+    const WireLine spot = spotLine(pts, row, first);
+    const auto known = [&](const WireLine& l) {
+      return l.squaredDistance(spot.origin) < WIRE_SEPARATION * WIRE_SEPARATION;
+    };
+    if (std::any_of(lines.begin(), lines.end(), known))
+      continue;
+    ++tried;
+    if (sampleRun(pts, row, spot) < min_length)
+      continue;
+    const WireLine line = refineLine(pts, spot);
+    if (std::abs(line.direction.dot(row.along)) < std::cos(WIRE_MAX_CROSSING))
+      continue;
+    double run = 0.0, cover = 0.0;
+    std::vector<int> inliers = lineRun(pts, line, &run, &cover);
+    lines.push_back(line);
+    if (run >= min_length && cover >= WIRE_MIN_COVER)
+      wires.push_back({line.direction, std::move(inliers), line});
+  }
+}
+
 std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
                         std::vector<Eigen::Vector3d>* directions) {
   if (pts.size() < 100)
@@ -287,20 +452,23 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     const WireLine line = bestLine(pts, candidates, rng);
     if (line.support < MIN_WIRE_SUPPORT)
       break;
-    double run = 0.0;
-    std::vector<int> inliers = lineRun(pts, line, &run);
+    double run = 0.0, cover = 0.0;
+    std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     settle(candidates, pts, line);
-    if (run < min_length)
+    if (run < min_length || cover < WIRE_MIN_COVER)
       continue;
     // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
     Points points;
     for (const int i : inliers)
       points.push_back(pts[i]);
-    found.push_back({principalAxis(points), std::move(inliers)});
+    found.push_back({principalAxis(points), std::move(inliers), line});
   }
+  std::vector<FoundWire> wires = alongTheRow(std::move(found));
+  if (!wires.empty())
+    addParallelWires(pts, min_length, wires);
   std::size_t removed = 0;
   std::vector<char> drop(pts.size(), 0);
-  for (const auto& wire : alongTheRow(std::move(found))) {
+  for (const auto& wire : wires) {
     directions->push_back(wire.direction);
     for (const int i : wire.points) {
       removed += !drop[i];

@@ -224,6 +224,49 @@ TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
   EXPECT_GT(onTrunk(out), 0.95 * onTrunk(voxelDownsample(pts, config.preprocess.voxel_size_m)));
 }
 
+TEST(Preprocess, FindsAWireWhoseNeighbourhoodIsNoLineAndKeepsAGappyRowOfBranches) {
+  // Three noisy wires along x across a 2 m crop. The top one has a branch trained along it
+  // 4 cm off and shoots crossing it every 10 cm, so no 10 cm ball on it is a line and only
+  // the wires below give the row's direction. Level branch pieces in line at another height,
+  // with gaps between them, are no wire.
+  Rng rng(5);
+  Points pts;
+  const auto wire = [&](double z, int n) {
+    for (int i = 0; i < n; ++i)
+      pts.emplace_back(rng.uniform(-1.0, 1.0), 0.06 + rng.normal(0.0, 0.004),
+                       z + rng.normal(0.0, 0.004));
+  };
+  wire(0.6, 2000);
+  wire(1.2, 2000);
+  wire(1.8, 2000);
+  const auto branch = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, int n) {
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d p = a + rng.uniform(0.0, 1.0) * (b - a);
+      pts.push_back(p + Eigen::Vector3d(rng.normal(0.0, 0.006), rng.normal(0.0, 0.006),
+                                        rng.normal(0.0, 0.006)));
+    }
+  };
+  branch({-1.0, 0.10, 1.8}, {1.0, 0.10, 1.8}, 3000);  // trained along the top wire
+  for (double x = -0.95; x < 1.0; x += 0.1)           // shoots crossing it
+    branch({x, 0.0, 1.70}, {x, 0.12, 1.90}, 150);
+  const double pieces[][2] = {{-1.0, -0.75}, {-0.55, -0.3}, {-0.1, 0.15}, {0.35, 0.6}, {0.8, 1.0}};
+  for (const auto& piece : pieces)
+    branch({piece[0], 0.3, 2.2}, {piece[1], 0.3, 2.2}, 400);
+  ModelerConfig config;
+  config.preprocess.voxel_size_m = 0.0;
+  PreprocessStats stats;
+  const Points out = preprocess(pts, config, &stats);
+  const auto near = [&](double y, double z) {
+    return std::count_if(out.begin(), out.end(), [&](const Eigen::Vector3d& p) {
+      return std::hypot(p.y() - y, p.z() - z) < 0.012;
+    });
+  };
+  EXPECT_LT(near(0.06, 1.8), 40) << "the top wire is removed";
+  EXPECT_LT(near(0.06, 1.2), 40);
+  EXPECT_GT(near(0.30, 2.2), 1600) << "the branch pieces in line stay";
+  EXPECT_GT(near(0.10, 1.8), 1500) << "the branch along the wire keeps its far side";
+}
+
 }  // namespace
 }  // namespace modeling
 }  // namespace dormant_tree_modeling
