@@ -452,10 +452,10 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     const WireLine line = bestLine(pts, candidates, rng);
     if (line.support < MIN_WIRE_SUPPORT)
       break;
-    double run = 0.0, cover = 0.0;
-    std::vector<int> inliers = lineRun(pts, line, &run, &cover);
+    double run = 0.0;
+    std::vector<int> inliers = lineRun(pts, line, &run);
     settle(candidates, pts, line);
-    if (run < min_length || cover < WIRE_MIN_COVER)
+    if (run < min_length)
       continue;
     // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
     Points points;

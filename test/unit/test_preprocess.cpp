@@ -228,7 +228,7 @@ TEST(Preprocess, FindsAWireWhoseNeighbourhoodIsNoLineAndKeepsAGappyRowOfBranches
   // Three noisy wires along x across a 2 m crop. The top one has a branch trained along it
   // 4 cm off and shoots crossing it every 10 cm, so no 10 cm ball on it is a line and only
   // the wires below give the row's direction. Level branch pieces in line at another height,
-  // with gaps between them, are no wire.
+  // with shoots like the top wire's and gaps between them, are no wire.
   Rng rng(5);
   Points pts;
   const auto wire = [&](double z, int n) {
@@ -250,8 +250,11 @@ TEST(Preprocess, FindsAWireWhoseNeighbourhoodIsNoLineAndKeepsAGappyRowOfBranches
   for (double x = -0.95; x < 1.0; x += 0.1)           // shoots crossing it
     branch({x, 0.0, 1.70}, {x, 0.12, 1.90}, 150);
   const double pieces[][2] = {{-1.0, -0.75}, {-0.55, -0.3}, {-0.1, 0.15}, {0.35, 0.6}, {0.8, 1.0}};
-  for (const auto& piece : pieces)
+  for (const auto& piece : pieces) {
     branch({piece[0], 0.3, 2.2}, {piece[1], 0.3, 2.2}, 400);
+    for (double x = piece[0] + 0.05; x < piece[1]; x += 0.1)  // shoots: no local line either
+      branch({x, 0.24, 2.1}, {x, 0.36, 2.3}, 150);
+  }
   ModelerConfig config;
   config.preprocess.voxel_size_m = 0.0;
   PreprocessStats stats;
