@@ -53,9 +53,9 @@ constexpr int WIRE_REFINE_ROUNDS = 2;        // fits of a sampled line to the po
 // WIRE_SPOT_STRIDE-th point, whose WIRE_SPOTS_TRIED densest cells are tried as wires.
 constexpr std::size_t WIRE_SPOT_STRIDE = 4;
 constexpr int WIRE_SPOTS_TRIED = 30;
-// Without a local line to vouch for it, a spot's line is a wire only when returns fill this
-// share of the WIRE_COVER_BIN bins along its longest run: the branches and trunks a line along
-// the row strings together leave gaps.
+// A line is a wire only when returns fill this share of the WIRE_COVER_BIN bins along its
+// longest run: a line stringing branches and trunks together along the row has gaps, and so
+// has a sampled line a few degrees off a wire, which would cut through the trunk it passes.
 constexpr double WIRE_COVER_BIN = 0.02;  // m
 constexpr double WIRE_MIN_COVER = 0.95;
 // The wires of a trellis are decimetres apart: a spot this near a wire's line is its fringe.
@@ -452,10 +452,10 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     const WireLine line = bestLine(pts, candidates, rng);
     if (line.support < MIN_WIRE_SUPPORT)
       break;
-    double run = 0.0;
-    std::vector<int> inliers = lineRun(pts, line, &run);
+    double run = 0.0, cover = 0.0;
+    std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     settle(candidates, pts, line);
-    if (run < min_length)
+    if (run < min_length || cover < WIRE_MIN_COVER)
       continue;
     // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
     Points points;
