@@ -162,10 +162,11 @@ double longestRun(std::vector<double>& t, std::size_t* from = nullptr) {
   return best;
 }
 
-/// The share of WIRE_COVER_BIN bins along the longest run of t that hold a projection.
-double runCover(std::vector<double> t) {
-  std::size_t first = 0;
-  const double run = longestRun(t, &first);
+/// The share of WIRE_COVER_BIN bins along a run that hold a projection.
+/// @param t projections, sorted (longestRun sorts them)
+/// @param first index in t where the run starts
+/// @param run the run's length
+double runCover(const std::vector<double>& t, std::size_t first, double run) {
   if (t.empty())
     return 0.0;
   const double start = t[first];
@@ -289,9 +290,10 @@ std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run,
       along.push_back((pts[i] - line.origin).dot(line.direction));
     }
   }
+  std::size_t first = 0;
+  *run = longestRun(along, &first);
   if (cover)
-    *cover = runCover(along);
-  *run = longestRun(along);
+    *cover = runCover(along, first, *run);
   return inliers;
 }
 
@@ -358,7 +360,7 @@ struct AlongTheRow {
   std::int64_t key(const Eigen::Vector3d& p) const {
     const auto a = static_cast<std::int64_t>(std::floor(p.dot(side) / WIRE_BAND));
     const auto b = static_cast<std::int64_t>(std::floor(p.dot(up) / WIRE_BAND));
-    return (a << 32) + b;
+    return a * (std::int64_t{1} << 32) + b;  // a shift of a negative a is undefined
   }
 
   /// The first keyed entry of each cell, the densest cells first.
