@@ -303,7 +303,8 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   auto cyl = fitThinCylinder(near.pts, guess.axis, bands.sigma, raw ? 0.0 : bands.scatter,
                              o.max_radius, o.seed, inliers);
   if (cyl && calibrated && !config.branches.raw_radius)
-    cyl->radius = config.branch_calibration.correct(cyl->radius, bands.sigma, MIN_BRANCH_RADIUS);
+    cyl->radius =
+        config.branch_calibration.correct(cyl->radius, bands.table_sigma, MIN_BRANCH_RADIUS);
   return cyl;
 }
 

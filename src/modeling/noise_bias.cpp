@@ -41,12 +41,16 @@ const double ROD_ELEVATIONS_RAD[] = {0.0, 20.0 * M_PI / 180.0, 40.0 * M_PI / 180
 // branch's by the trunk radius where it leaves: primaries are 0.3..0.6 of it.
 constexpr double TRUNK_TO_BRANCH = 2.5;
 constexpr double MIN_BRANCH_BOUND_M = 0.025;
-// The noise estimator reads thick trunk slices: a 5 cm radius stands for them.
+// The tables' noise axis is what the estimator reads on slices of this radius (the standard
+// reading); on a thinner trunk it reads less for the same noise (standardNoiseReading).
 constexpr double ESTIMATOR_RADIUS_M = 0.05;
+// Slice radii the estimator's reading is modelled at are rounded to this (m).
+constexpr double READING_RADIUS_STEP_M = 0.001;
 constexpr double MIN_AXIS_STEP_M = 1e-5;
 // Keys of the two tables in the cache.
 constexpr int TRUNK_TABLE = 0;
 constexpr int BRANCH_TABLE = 1;
+constexpr std::uint64_t READING_SEED = 319993ULL;
 
 /// A return on a cylinder of radius r about `axis` through the origin, seen along beam b
 /// (unit, not parallel to the axis), `lateral` across the silhouette (-1..1) and `along` the
@@ -137,33 +141,41 @@ double rodBias(double r, double sigma, std::uint64_t seed) {
   return n > 0 ? sum / n : 0.0;
 }
 
-/// What the modeler's noise estimator (estimateNoiseSigma: the radial residuals of thick trunk
-/// slices) reports for returns of range noise `sigma`: the tables are looked up by it.
-double estimatedNoise(const ModelerConfig& config, double sigma, std::uint64_t seed) {
+/// What the modeler's noise estimator (estimateNoiseSigma: the radial residuals of trunk slices,
+/// pooled) reports for returns of range noise `sigma` on one slice of each of `slice_radii`. It
+/// keeps the residuals within half a slice's radius, so on slices not much thicker than the
+/// noise it reads low.
+double estimatedNoise(const ModelerConfig& config, double sigma,
+                      const std::vector<double>& slice_radii, std::uint64_t seed) {
   std::vector<double> estimates;
   for (int rep = 0; rep < REPEATS; ++rep) {
     Rng rng = Rng::derive(seed, rep);
-    const Points2 plane = noisySlice(ESTIMATOR_RADIUS_M, sigma, rng);
-    const CircleRansacConfig o = sliceOptions(config, ESTIMATOR_RADIUS_M, sigma, rng.next());
-    const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
-    if (!c)
-      continue;
     std::vector<double> residuals;
-    for (const auto& q : plane) {
-      const double d = (q - c->circle.center).norm() - c->circle.radius;
-      if (std::abs(d) < 0.5 * c->circle.radius)
-        residuals.push_back(d);
+    for (const double r : slice_radii) {
+      const Points2 plane = noisySlice(r, sigma, rng);
+      const CircleRansacConfig o = sliceOptions(config, r, sigma, rng.next());
+      const auto c = measureSliceCircle(plane, o, true, o.min_radius, o.max_radius);
+      if (!c)
+        continue;
+      for (const auto& q : plane) {
+        const double d = (q - c->circle.center).norm() - c->circle.radius;
+        if (std::abs(d) < 0.5 * c->circle.radius)
+          residuals.push_back(d);
+      }
     }
-    estimates.push_back(noiseFromRadialResiduals(std::move(residuals)));
+    if (!residuals.empty())
+      estimates.push_back(noiseFromRadialResiduals(std::move(residuals)));
   }
   return estimates.empty() ? sigma : median(std::move(estimates));
 }
 
-/// The noise axis: the estimator's reading of each of NOISE_M, kept ascending.
-std::vector<double> estimatedNoiseAxis(const ModelerConfig& config, std::uint64_t seed) {
+/// The noise axis: the estimator's reading of each of NOISE_M on slices of `slice_radii`, kept
+/// ascending.
+std::vector<double> estimatedNoiseAxis(const ModelerConfig& config,
+                                       const std::vector<double>& slice_radii, std::uint64_t seed) {
   std::vector<double> axis(NOISE_M.size());
   parallelFor(static_cast<int>(NOISE_M.size()), [&](int k) {
-    axis[k] = estimatedNoise(config, NOISE_M[k], Rng::derive(seed, 1000 + k).next());
+    axis[k] = estimatedNoise(config, NOISE_M[k], slice_radii, Rng::derive(seed, 1000 + k).next());
   });
   for (std::size_t k = 1; k < axis.size(); ++k)
     axis[k] = std::max(axis[k], axis[k - 1] + MIN_AXIS_STEP_M);
@@ -177,7 +189,7 @@ RadiusCalibration tabulate(const ModelerConfig& config, const std::vector<double
                            std::uint64_t seed, Bias bias) {
   RadiusCalibration t;
   t.radii = radii;
-  t.noise = estimatedNoiseAxis(config, seed);
+  t.noise = estimatedNoiseAxis(config, {ESTIMATOR_RADIUS_M}, seed);
   t.bias.assign(radii.size() * NOISE_M.size(), 0.0);
   const int cells = static_cast<int>(t.bias.size());
   parallelFor(cells, [&](int i) {
@@ -199,7 +211,48 @@ RadiusCalibration cached(const Key& key, const std::function<RadiusCalibration()
   return it->second;
 }
 
+/// The estimator's readings on slices of `slice_radii` (rounded to READING_RADIUS_STEP_M),
+/// computed once per configuration and radii.
+std::vector<double> readingAxis(const ModelerConfig& config,
+                                const std::vector<double>& slice_radii) {
+  std::vector<long> steps;
+  std::vector<double> radii;
+  for (const double r : slice_radii) {
+    steps.push_back(std::max(1L, std::lround(r / READING_RADIUS_STEP_M)));
+    radii.push_back(steps.back() * READING_RADIUS_STEP_M);
+  }
+  const auto key = std::make_tuple(config.fit.circle_threshold_m, config.fit.ransac_iterations,
+                                   config.noise.derive_parameters, config.seed, steps);
+  static std::mutex mutex;
+  static std::map<decltype(key), std::vector<double>> axes;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = axes.find(key);
+  if (it == axes.end())
+    it = axes.emplace(key, estimatedNoiseAxis(config, radii, config.seed * READING_SEED)).first;
+  return it->second;
+}
+
+/// Piecewise-linear map of v from the ascending axis `from` onto `to` (same length); beyond
+/// the ends in proportion to the end value.
+double mapAlong(const std::vector<double>& from, const std::vector<double>& to, double v) {
+  if (v <= from.front())
+    return v * to.front() / from.front();
+  if (v >= from.back())
+    return v * to.back() / from.back();
+  const std::size_t k = std::upper_bound(from.begin(), from.end(), v) - from.begin();
+  const double t = (v - from[k - 1]) / (from[k] - from[k - 1]);
+  return to[k - 1] + t * (to[k] - to[k - 1]);
+}
+
 }  // namespace
+
+double standardNoiseReading(const ModelerConfig& config, double sigma,
+                            const std::vector<double>& slice_radii) {
+  if (!(sigma > 0.0) || slice_radii.empty())
+    return sigma;
+  return mapAlong(readingAxis(config, slice_radii), readingAxis(config, {ESTIMATOR_RADIUS_M}),
+                  sigma);
+}
 
 RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {
   const auto key =

@@ -105,11 +105,13 @@ std::string outsideRange(const char* what, const std::vector<double>& radii, dou
   return text;
 }
 
-/// Which calibration the diameters went through, and where the tree needed it beyond its rig.
+/// Which calibration the diameters went through, and where the tree needed it beyond its rig;
+/// sigma is the noise as the tables read it (TrunkModel::table_sigma).
 DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
-                                      double sigma) {
+                                      double estimated_sigma, double sigma) {
   DiameterCorrection d;
-  d.noise_sigma = sigma;
+  d.noise_sigma = estimated_sigma;
+  d.table_noise_sigma = sigma;
   if (!config.noise.correct_bias)
     return d;
   const SensorCalibration& cal = config.calibration;
@@ -387,6 +389,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   watch.lap("track");
   const TrunkModel trunk = modelTrunk(pts, region.points, region.axis, region.radius, config_);
   result.noise_sigma = trunk.noise_sigma;
+  result.table_noise_sigma = trunk.table_sigma;
   watch.lap("trunk");
   requireScannedSurface(trunk.noise_sigma);
   const auto branches = modelBranches(pts, index, trunk, region.points, config_,
@@ -404,7 +407,7 @@ ModelResult TreeModeler::model(const Points& input) const {
     for (const int k : branches[b].inliers)
       result.classes[k] = PointClass::PRIMARY;
   }
-  model.correction = describeCorrection(config_, model, trunk.noise_sigma);
+  model.correction = describeCorrection(config_, model, trunk.noise_sigma, trunk.table_sigma);
   model.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -11,6 +11,7 @@
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/noise_band.h"
+#include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 #include "dormant_tree_modeling/modeling/taper_profile.h"
 
@@ -500,8 +501,9 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 }
 
 double estimateNoiseSigma(const Points& pts, const Centerline& line,
-                          const std::vector<Slice>& slices, double slice_height) {
-  std::vector<double> residuals;
+                          const std::vector<Slice>& slices, double slice_height,
+                          std::vector<double>* slice_radii) {
+  std::vector<double> residuals, radii;
   for (const auto& sl : slices) {
     if (!sl.has_circle || sl.radius < 0.02)
       continue;
@@ -512,12 +514,19 @@ double estimateNoiseSigma(const Points& pts, const Centerline& line,
       if (std::abs(along) > 0.5 * slice_height)
         continue;
       const double d = (w - along * dir).norm() - sl.radius;
-      if (std::abs(d) < 0.5 * sl.radius)
+      if (std::abs(d) < 0.5 * sl.radius) {
         residuals.push_back(d);
+        radii.push_back(sl.radius);
+      }
     }
   }
   if (residuals.size() < 200)
     return -1.0;
+  if (slice_radii) {
+    // The quartiles of the residuals' slice radii stand for the slices.
+    std::sort(radii.begin(), radii.end());
+    *slice_radii = {radii[radii.size() / 4], radii[radii.size() / 2], radii[3 * radii.size() / 4]};
+  }
   return noiseFromRadialResiduals(std::move(residuals));
 }
 
@@ -688,14 +697,18 @@ SliceBounds sliceBounds(double initial_radius) {
 }
 
 /// The region's range noise: the configured one, or estimated from the slices.
+/// With slice_radii, radii standing for the slices it was read on (none when given).
 double trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
-                  const std::vector<Slice>& slices, const ModelerConfig& config) {
+                  const std::vector<Slice>& slices, const ModelerConfig& config,
+                  std::vector<double>* slice_radii) {
+  slice_radii->clear();
   if (config.noise.sigma_m >= 0.0)
     return config.noise.sigma_m;
   Points region_pts;
   for (const int i : region)
     region_pts.push_back(pts[i]);
-  const double estimate = estimateNoiseSigma(region_pts, line, slices, config.trunk.slice_height_m);
+  const double estimate =
+      estimateNoiseSigma(region_pts, line, slices, config.trunk.slice_height_m, slice_radii);
   return estimate > 0.0 ? estimate : 0.0;
 }
 
@@ -791,8 +804,16 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     slices = computeSlices(pts, region, line, s, dist, h, config.fit.circle_threshold_m, bounds,
                            nullptr, 0.0, std::nullopt, config);
   }
-  const double sigma = trunkNoise(pts, region, line, slices, config);
+  std::vector<double> slice_radii;
+  const double sigma = trunkNoise(pts, region, line, slices, config, &slice_radii);
   trunk.noise_sigma = sigma;
+  // A calibration's rows are the estimate as its rig read it (raw radii: calibrate_diameters
+  // measuring one), and take the tree's likewise; the noise part alone models range noise, and
+  // reads it as its 5 cm slices do.
+  const bool noise_part_alone = !config.calibration.given() && !config.branches.raw_radius;
+  trunk.table_sigma = config.noise.correct_bias && noise_part_alone
+                          ? standardNoiseReading(config, sigma, slice_radii)
+                          : sigma;
   const double scatter =
       config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;
   trunk.scatter = scatter;
@@ -806,7 +827,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     const auto expected = expectedRadii(slices);
     slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
                            config.fit.constrain ? &expected : nullptr,
-                           config.trunk.radius_continuity, sigma, config);
+                           config.trunk.radius_continuity, trunk.table_sigma, config);
   }
   trunk.slices = slices;
   trunk.centerline = line;

@@ -4,15 +4,18 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 
 #include "dormant_tree_modeling/calibration/rig_calibration.h"
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/evaluation/matching.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
 #include "dormant_tree_modeling/modeling/sensor_calibration.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
+#include "dormant_tree_modeling/modeling/trunk_model.h"
 #include "dormant_tree_modeling/registration/multi_view.h"
 #include "dormant_tree_modeling/simulation/calibration_rig.h"
 #include "dormant_tree_modeling/simulation/dataset.h"
@@ -37,6 +40,49 @@ TEST(NoiseBias, ThickSectionsAreUnbiasedAndThinRodsWidenWithTheNoise) {
   EXPECT_GT(branch.biasAt(0.003, 0.012), branch.biasAt(0.003, 0.003) + 0.002);
   // Seeded: the same tables again.
   EXPECT_EQ(modeling::trunkNoiseBias(config).bias, trunk.bias);
+}
+
+/// A vertical trunk of radius r, 1 m tall, seen from 8 views all around by level beams, each
+/// return displaced by Gaussian range noise sigma along its beam.
+modeling::Points noisyTrunk(double r, double sigma, std::uint64_t seed) {
+  Rng rng(seed);
+  modeling::Points pts;
+  for (int v = 0; v < 8; ++v) {
+    const double az = 2.0 * M_PI * v / 8;
+    const Eigen::Vector3d b(std::cos(az), std::sin(az), 0.0);
+    const Eigen::Vector3d across(-b.y(), b.x(), 0.0);
+    for (int k = 0; k < 3000; ++k) {
+      const double u = rng.uniform(-r, r);
+      pts.push_back(u * across - std::sqrt(r * r - u * u) * b + sigma * rng.normal() * b +
+                    Eigen::Vector3d(0.0, 0.0, rng.uniform(0.0, 1.0)));
+    }
+  }
+  return pts;
+}
+
+TEST(NoiseBias, TheTablesReadTheNoiseAsFiveCentimetreSlicesDoOnAnyTrunk) {
+  const modeling::ModelerConfig config;
+  const double sigma = 0.012;
+  std::vector<modeling::TrunkModel> trunks;
+  for (const double r : {0.022, 0.05}) {
+    const auto pts = noisyTrunk(r, sigma, 17);
+    std::vector<int> region(pts.size());
+    std::iota(region.begin(), region.end(), 0);
+    trunks.push_back(modeling::modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 1}}, r, config));
+  }
+  const auto& thin = trunks[0];
+  const auto& thick = trunks[1];
+  // The estimator keeps residuals within half a slice's radius: a trunk of 22 mm reads the same
+  // noise a third below one of 50 mm (7.0 against 10.5 mm) ...
+  EXPECT_LT(thin.noise_sigma, 0.75 * thick.noise_sigma);
+  // ... and the tables read both much as 5 cm slices do (9.9 and 10.7 mm).
+  const double raw_gap = thick.noise_sigma - thin.noise_sigma;
+  EXPECT_LT(std::abs(thick.table_sigma - thin.table_sigma), 0.3 * raw_gap);
+  EXPECT_NEAR(thin.table_sigma, thick.table_sigma, 0.1 * thick.table_sigma);
+  EXPECT_NEAR(thick.table_sigma, thick.noise_sigma, 0.05 * thick.noise_sigma);
+  // Read on 5 cm slices, or on none, it stays as it is.
+  EXPECT_NEAR(modeling::standardNoiseReading(config, 0.008, {0.05}), 0.008, 1e-12);
+  EXPECT_EQ(modeling::standardNoiseReading(config, 0.008, {}), 0.008);
 }
 
 TEST(NoiseBias, TheFootprintIsAddedWithItsNoiseHeldToItsRows) {
@@ -299,11 +345,16 @@ TEST_F(RigCalibration, ATreeOfTheSameWorldMeasuresWithinBoundsAndSaysWhichCalibr
   const auto back = io::modelFromJson(io::modelToJson(model));
   EXPECT_EQ(back.correction.calibration, "sim");
   EXPECT_EQ(back.correction.warnings, model.correction.warnings);
+  EXPECT_DOUBLE_EQ(back.correction.table_noise_sigma, model.correction.table_noise_sigma);
   // Without a calibration the model says it corrected the noise alone.
   const auto plain = modeling::TreeModeler(modeling::ModelerConfig{}).model(cloud).model;
   ASSERT_FALSE(plain.correction.warnings.empty());
   EXPECT_NE(plain.correction.warnings[0].find("no sensor calibration"), std::string::npos);
   EXPECT_TRUE(plain.correction.calibration.empty());
+  // The rig's rows are the estimate as read: a calibrated tree looks its own up likewise. The
+  // noise part alone reads it as 5 cm slices would (this tree's trunk is thinner: more).
+  EXPECT_EQ(model.correction.table_noise_sigma, model.correction.noise_sigma);
+  EXPECT_GT(plain.correction.table_noise_sigma, plain.correction.noise_sigma);
 }
 
 }  // namespace

@@ -19,6 +19,19 @@ RadiusCalibration trunkNoiseBias(const ModelerConfig& config);
 /// all around.
 RadiusCalibration branchNoiseBias(const ModelerConfig& config);
 
+/// @brief The noise estimate as the noise part's tables read it. The estimator
+/// (estimateNoiseSigma) keeps the radial residuals within half a slice's radius: on a trunk
+/// whose slices are not much thicker than the noise it reads less than on the 5 cm slices the
+/// tables' noise axis stands for, and thin branches came out too thick (12 mm range noise, no
+/// footprint, no calibration: +5.9 mm). Maps an estimate read on slices of `slice_radii` to
+/// what 5 cm slices give for the same range noise, through the estimator's modelled readings.
+/// Range noise only: a footprint's widening reads otherwise (thinner trunks read more), so the
+/// modeler applies this without a calibration only (TrunkModel::table_sigma).
+/// @param sigma the estimate (m)
+/// @param slice_radii radii standing for the slices it was read on (m); none leaves sigma
+double standardNoiseReading(const ModelerConfig& config, double sigma,
+                            const std::vector<double>& slice_radii);
+
 /// @brief The table the stages apply: the noise part plus a footprint part (a calibration's
 /// table, its noise axis clamped to its own rows: the footprint does not grow with noise), on
 /// the noise part's grid. An empty footprint leaves the noise part.

@@ -41,6 +41,9 @@ struct DiameterCorrection {
   std::string calibration;       ///< the sensor calibration's name; empty: none was given
   std::string calibration_hash;  ///< of its file (SensorCalibration::hash)
   double noise_sigma = 0.0;      ///< m, the range noise the modeler estimated (or was given)
+  /// m, that estimate as the radius tables read it: without a calibration what 5 cm slices
+  /// would read (standardNoiseReading), with one the estimate itself, as its rig's rows are
+  double table_noise_sigma = 0.0;
   /// Each said once: no calibration (noise part only), or the tree needing the tables outside
   /// the radii or noise the calibration's rig covered.
   std::vector<std::string> warnings;

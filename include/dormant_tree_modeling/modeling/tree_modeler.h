@@ -27,8 +27,9 @@ struct ModelResult {
   /// What preprocessing dropped or coarsened that the user should hear of (stray points far
   /// from the bulk, a grid coarser than voxel_size): one sentence each, for the tool and the node
   std::vector<std::string> notices;
-  double noise_sigma = 0.0;  ///< range noise estimate used (m)
-  double split_error = 0.0;  ///< e_t used (m)
+  double noise_sigma = 0.0;        ///< range noise estimate used (m)
+  double table_noise_sigma = 0.0;  ///< as the radius tables read it (TrunkModel::table_sigma), m
+  double split_error = 0.0;        ///< e_t used (m)
   /// neighbourGrowthDimension of the modeled points: about 2 for scanned surfaces, 3 for a
   /// cloud filling a volume
   double structure_dimension = 0.0;

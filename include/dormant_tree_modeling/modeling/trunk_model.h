@@ -71,6 +71,10 @@ struct TrunkModel {
   std::vector<Cylinder> cylinders;  ///< one per segment, bottom to top (failed fits left out)
   std::vector<std::pair<double, double>> cylinder_ranges;  ///< arc-length range of each cylinder
   double noise_sigma = 0.0;                                ///< range noise estimate (m)
+  /// The estimate as the radius tables read it (m): without a calibration what 5 cm slices give
+  /// for the same range noise (standardNoiseReading); with a calibration, with raw branch radii
+  /// (calibrate_diameters measuring a rig) or without the bias correction, noise_sigma.
+  double table_sigma = 0.0;
   /// Total scatter removed from radii: sqrt(noise_sigma^2 + beam_spread^2) when the bias
   /// correction is on, else 0 (m).
   double scatter = 0.0;
@@ -107,8 +111,11 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane,
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
 /// parts: 1.4826 MAD of the radial residuals, x sqrt(3/2) because a return's radial residual
 /// carries on average 2/3 of its range variance. Nothing when too few slices qualify.
+/// @param slice_radii when given, receives the quartiles of the radii of the slices the
+/// residuals came from (m)
 double estimateNoiseSigma(const Points& pts, const Centerline& line,
-                          const std::vector<Slice>& slices, double slice_height);
+                          const std::vector<Slice>& slices, double slice_height,
+                          std::vector<double>* slice_radii = nullptr);
 
 /// @brief Partition arc lengths from eta (step 2): where a positive derivative follows a run of
 /// at least `zero_run` near-zero derivatives. Includes 0 and the top.
