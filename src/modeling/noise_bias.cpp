@@ -199,15 +199,15 @@ RadiusCalibration tabulate(const ModelerConfig& config, const std::vector<double
   return t;
 }
 
-/// Tables computed before, by what they depend on.
-template <typename Key>
-RadiusCalibration cached(const Key& key, const std::function<RadiusCalibration()>& make) {
+/// Tables (and noise axes) computed before, by what they depend on.
+template <typename Value, typename Key>
+Value cached(const Key& key, const std::function<Value()>& make) {
   static std::mutex mutex;
-  static std::map<Key, RadiusCalibration> tables;
+  static std::map<Key, Value> values;
   std::lock_guard<std::mutex> lock(mutex);
-  auto it = tables.find(key);
-  if (it == tables.end())
-    it = tables.emplace(key, make()).first;
+  auto it = values.find(key);
+  if (it == values.end())
+    it = values.emplace(key, make()).first;
   return it->second;
 }
 
@@ -223,13 +223,8 @@ std::vector<double> readingAxis(const ModelerConfig& config,
   }
   const auto key = std::make_tuple(config.fit.circle_threshold_m, config.fit.ransac_iterations,
                                    config.noise.derive_parameters, config.seed, steps);
-  static std::mutex mutex;
-  static std::map<decltype(key), std::vector<double>> axes;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto it = axes.find(key);
-  if (it == axes.end())
-    it = axes.emplace(key, estimatedNoiseAxis(config, radii, config.seed * READING_SEED)).first;
-  return it->second;
+  return cached<std::vector<double>>(
+      key, [&] { return estimatedNoiseAxis(config, radii, config.seed * READING_SEED); });
 }
 
 /// Piecewise-linear map of v from the ascending axis `from` onto `to` (same length); beyond
@@ -258,7 +253,7 @@ RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {
   const auto key =
       std::make_tuple(TRUNK_TABLE, config.fit.circle_threshold_m, config.fit.ransac_iterations,
                       config.noise.derive_parameters, config.seed);
-  return cached(key, [&] {
+  return cached<RadiusCalibration>(key, [&] {
     return tabulate(
         config, TRUNK_RADII_M, config.seed * 104729ULL,
         [&](double r, double s, std::uint64_t seed) { return sliceBias(config, r, s, seed); });
@@ -269,8 +264,8 @@ RadiusCalibration branchNoiseBias(const ModelerConfig& config) {
   const auto key =
       std::make_tuple(BRANCH_TABLE, config.fit.circle_threshold_m, config.fit.ransac_iterations,
                       config.noise.derive_parameters, config.seed);
-  return cached(key,
-                [&] { return tabulate(config, BRANCH_RADII_M, config.seed * 130363ULL, rodBias); });
+  return cached<RadiusCalibration>(
+      key, [&] { return tabulate(config, BRANCH_RADII_M, config.seed * 130363ULL, rodBias); });
 }
 
 double footprintBiasAt(const RadiusCalibration& footprint, double radius, double sigma) {
