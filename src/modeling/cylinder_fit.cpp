@@ -267,6 +267,13 @@ constexpr std::size_t MIN_BENT_SLICES = 4;
 // this factor of the moment's.
 constexpr double ARC_MIN_SIGMAS = 2.0;
 constexpr double ARC_RADIUS_SHARE = 2.0;
+// A raw radius is this quantile of the slices' moments, taper taken out: shoots and spurs on a
+// branch add to the moments of the slices they cross and never take from any, so a median
+// reads a branch with shoots thicker than the rig's bare rods it is calibrated on. The tables
+// map the quantile of clean slices as they mapped the median.
+constexpr double SLICE_MOMENT_QUANTILE = 0.3;
+// The taper is a slope fitted to at least this many slices; fewer keep their moments.
+constexpr std::size_t MIN_TAPER_SLICES = 4;
 
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
@@ -423,27 +430,55 @@ class BentAxis {
   Eigen::Vector2d shift_ = Eigen::Vector2d::Zero();
 };
 
-/// The median over slices (of at least MIN_THIN_POINTS) of the mean squared distance from the
-/// axis within `reach`, or of all points when no slice has enough; nullopt with fewer than
-/// MIN_THIN_POINTS. Without a scatter to remove (a raw moment, for a calibration) each slice's
-/// farthest fifth is left out: spurs and shoots on the branch. The calibration absorbs what the
-/// trimming takes from the scatter.
+/// One slice's moment: the mean squared distance from the axis of its points within reach.
+struct SliceMoment {
+  double position;  ///< the slice's index along the axis
+  double moment;    ///< m^2
+};
+
+/// The slices' moments taken to the middle of their run along a linear taper of their RMS
+/// radii. The slope is Theil-Sen's (the median of the pairwise slopes), which the few slices a
+/// shoot crosses do not tilt.
+void removeTaper(std::vector<SliceMoment>& slices) {
+  if (slices.size() < MIN_TAPER_SLICES)
+    return;
+  std::vector<double> slopes;
+  for (std::size_t a = 0; a < slices.size(); ++a) {
+    for (std::size_t b = a + 1; b < slices.size(); ++b) {
+      slopes.push_back((std::sqrt(slices[b].moment) - std::sqrt(slices[a].moment)) /
+                       (slices[b].position - slices[a].position));
+    }
+  }
+  const double slope = median(std::move(slopes));
+  const double middle = 0.5 * (slices.front().position + slices.back().position);
+  for (auto& sl : slices) {
+    const double rms = std::max(0.0, std::sqrt(sl.moment) - slope * (sl.position - middle));
+    sl.moment = rms * rms;
+  }
+}
+
+/// The moment over slices (of at least MIN_THIN_POINTS) of the squared distances from the axis
+/// within `reach`, or of all points when no slice has enough; nullopt with fewer than
+/// MIN_THIN_POINTS. With a scatter to remove, the median of the slices' moments. Without (a raw
+/// moment, for a table or a calibration to map), shoots and spurs are left out: each slice's
+/// farthest fifth, and the slices they cross, by taking SLICE_MOMENT_QUANTILE of the moments
+/// with the taper removed. The tables absorb what that takes from the scatter.
 std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& used,
                                   const Cylinder& cyl, const BentAxis& bent, double reach,
                                   double scatter) {
+  const bool raw = scatter <= 0.0;
   std::map<long, std::vector<double>> sq_by_slice;
   for (const int i : used) {
     const double dist = bent.distance(pts[i]);
     if (dist < reach)
       sq_by_slice[thinSlice(cyl, pts[i])].push_back(dist * dist);
   }
-  std::vector<double> moments;
+  std::vector<SliceMoment> slices;
   double total = 0.0;
   int total_n = 0;
-  for (auto& kv : sq_by_slice) {
-    auto& v = kv.second;
+  for (auto& [index, v] : sq_by_slice) {
     std::size_t keep = v.size();
-    if (scatter <= 0.0 && v.size() >= 5) {
+    if (raw && v.size() >= 5) {
       keep = (v.size() * 4 + 4) / 5;
       std::nth_element(v.begin(), v.begin() + (keep - 1), v.end());
     }
@@ -453,11 +488,18 @@ std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& use
     total += sum;
     total_n += static_cast<int>(keep);
     if (static_cast<int>(keep) >= MIN_THIN_POINTS)
-      moments.push_back(sum / keep);
+      slices.push_back({static_cast<double>(index), sum / keep});
   }
   if (total_n < MIN_THIN_POINTS)
     return std::nullopt;
-  return moments.empty() ? total / total_n : median(std::move(moments));
+  if (slices.empty())
+    return total / total_n;
+  if (raw)
+    removeTaper(slices);
+  std::vector<double> moments;
+  for (const auto& sl : slices)
+    moments.push_back(sl.moment);
+  return raw ? quantileInPlace(moments, SLICE_MOMENT_QUANTILE) : median(std::move(moments));
 }
 
 /// Centre and length from the used points' extent along the axis, and their mean |d - r|.
