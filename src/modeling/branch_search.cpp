@@ -201,7 +201,8 @@ void BranchSearch::examine(const Candidate& candidate) {
   if (!guess)
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   std::vector<int> inliers;
-  auto cyl = fit(near, seg, *guess, &inliers);
+  double wood_radius = 0.0;
+  auto cyl = fit(near, seg, *guess, &inliers, &wood_radius);
   if (!cyl || static_cast<int>(inliers.size()) < config.branches.min_points)
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   if (cyl->axis.dot(guess->radial) < 0.0)
@@ -231,7 +232,7 @@ void BranchSearch::examine(const Candidate& candidate) {
       rejected_->push_back(rejection(candidates_.pts, wire, BranchRejection::WIRE));
     return;
   }
-  accept(candidate, near, *cyl, inliers, attachment, reaches_surface);
+  accept(candidate, near, *cyl, wood_radius, inliers, attachment, reaches_surface);
 }
 
 BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) const {
@@ -282,8 +283,11 @@ std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& n
 
 /// The cylinder of the near part: ours a thin-cylinder fit (its radius through the branch
 /// calibration when there is one), the paper's a RANSAC cylinder.
+/// The branch's cylinder, its radius what its points spread over (shoots and spurs included:
+/// the checks and the extraction work with that), and in *wood_radius the radius it reports.
 std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& seg,
-                                          const Direction& guess, std::vector<int>* inliers) {
+                                          const Direction& guess, std::vector<int>* inliers,
+                                          double* wood_radius) {
   const ModelerConfig& config = context_.config;
   const BranchBands& bands = context_.bands;
   CylinderRansacConfig o;
@@ -295,16 +299,27 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.max_radius =
       config.fit.constrain ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
   o.seed = config.seed * FIT_SEED_FACTOR + stream_++;
-  if (!config.fit.constrain)
-    return ransacCylinder(near.pts, guess.axis, o, inliers);
+  if (!config.fit.constrain) {
+    auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);
+    if (cyl)
+      *wood_radius = cyl->radius;
+    return cyl;
+  }
   // With a branch calibration the fit reports the raw RMS radius and the table maps it.
   const bool calibrated = config.noise.correct_bias && config.branch_calibration.valid();
   const bool raw = calibrated || config.branches.raw_radius;
+  double spread = 0.0;
   auto cyl = fitThinCylinder(near.pts, guess.axis, bands.sigma, raw ? 0.0 : bands.scatter,
-                             o.max_radius, o.seed, inliers);
-  if (cyl && calibrated && !config.branches.raw_radius)
-    cyl->radius =
-        config.branch_calibration.correct(cyl->radius, bands.table_sigma, MIN_BRANCH_RADIUS);
+                             o.max_radius, o.seed, inliers, &spread);
+  if (!cyl)
+    return cyl;
+  *wood_radius = cyl->radius;
+  if (calibrated && !config.branches.raw_radius) {
+    const auto& table = config.branch_calibration;
+    *wood_radius = table.correct(*wood_radius, bands.table_sigma, MIN_BRANCH_RADIUS);
+    spread = table.correct(spread, bands.table_sigma, MIN_BRANCH_RADIUS);
+  }
+  cyl->radius = spread;
   return cyl;
 }
 
@@ -360,8 +375,8 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkPlace(
 }
 
 void BranchSearch::accept(const Candidate& candidate, const NearPart& near, const Cylinder& fit,
-                          const std::vector<int>& inliers, const Eigen::Vector3d& attachment,
-                          bool reaches_surface) {
+                          double wood_radius, const std::vector<int>& inliers,
+                          const Eigen::Vector3d& attachment, bool reaches_surface) {
   const ModelerConfig& config = context_.config;
   const BranchBands& bands = context_.bands;
   Points in;
@@ -371,6 +386,7 @@ void BranchSearch::accept(const Candidate& candidate, const NearPart& near, cons
     branch.inliers.push_back(near.index[i]);
   }
   branch.cylinder = fit;
+  branch.cylinder.radius = wood_radius;
   if (config.noise.correct_bias && !config.fit.constrain) {
     branch.cylinder.radius =
         noiseCorrectedRadius(fit, in, bands.sigma, bands.threshold, MIN_BRANCH_RADIUS);

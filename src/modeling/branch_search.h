@@ -114,7 +114,7 @@ class BranchSearch {
   NearPart nearPart(const std::vector<int>& cluster) const;
   std::optional<Direction> direction(const NearPart& near, const Cylinder& seg) const;
   std::optional<Cylinder> fit(const NearPart& near, const Cylinder& seg, const Direction& guess,
-                              std::vector<int>* inliers);
+                              std::vector<int>* inliers, double* wood_radius);
   std::optional<Verdict> checkDirection(const Candidate& candidate, const Cylinder& fit,
                                         const Cylinder& seg, const Direction& guess,
                                         double gap) const;
@@ -122,8 +122,8 @@ class BranchSearch {
                                     const Eigen::Vector3d& attachment) const;
   bool reachesSurface(const NearPart& near) const;
   void accept(const Candidate& candidate, const NearPart& near, const Cylinder& fit,
-              const std::vector<int>& inliers, const Eigen::Vector3d& attachment,
-              bool reaches_surface);
+              double wood_radius, const std::vector<int>& inliers,
+              const Eigen::Vector3d& attachment, bool reaches_surface);
   void reject(const Candidate& candidate, int segment, Verdict verdict);
   bool splitAlongRay(const Candidate& candidate, const Points& cluster_pts, int segment);
   bool splitInHalves(const Candidate& candidate, const Points& cluster_pts);

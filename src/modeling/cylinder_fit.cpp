@@ -457,15 +457,23 @@ void removeTaper(std::vector<SliceMoment>& slices) {
   }
 }
 
-/// The moment over slices (of at least MIN_THIN_POINTS) of the squared distances from the axis
+/// What a branch's slices measure: the moment its points spread over, and the one its wood
+/// reads (m^2).
+struct BranchMoments {
+  double spread;  ///< the median over slices: sets the fit's reach, so its points
+  double wood;    ///< the radius reported
+};
+
+/// The moments over slices (of at least MIN_THIN_POINTS) of the squared distances from the axis
 /// within `reach`, or of all points when no slice has enough; nullopt with fewer than
-/// MIN_THIN_POINTS. With a scatter to remove, the median of the slices' moments. Without (a raw
-/// moment, for a table or a calibration to map), shoots and spurs are left out: each slice's
-/// farthest fifth, and the slices they cross, by taking SLICE_MOMENT_QUANTILE of the moments
-/// with the taper removed. The tables absorb what that takes from the scatter.
-std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& used,
-                                  const Cylinder& cyl, const BentAxis& bent, double reach,
-                                  double scatter) {
+/// MIN_THIN_POINTS. With a scatter to remove, both are the median of the slices' moments.
+/// Without (a raw moment, for a table or a calibration to map), shoots and spurs are left out
+/// of the wood: each slice's farthest fifth, and the slices they cross, by taking
+/// SLICE_MOMENT_QUANTILE of the moments with the taper removed. The tables absorb what that
+/// takes from the scatter.
+std::optional<BranchMoments> sliceMoments(const Points& pts, const std::vector<int>& used,
+                                          const Cylinder& cyl, const BentAxis& bent, double reach,
+                                          double scatter) {
   const bool raw = scatter <= 0.0;
   std::map<long, std::vector<double>> sq_by_slice;
   for (const int i : used) {
@@ -493,13 +501,17 @@ std::optional<double> sliceMoment(const Points& pts, const std::vector<int>& use
   if (total_n < MIN_THIN_POINTS)
     return std::nullopt;
   if (slices.empty())
-    return total / total_n;
-  if (raw)
-    removeTaper(slices);
+    return BranchMoments{total / total_n, total / total_n};
   std::vector<double> moments;
   for (const auto& sl : slices)
     moments.push_back(sl.moment);
-  return raw ? quantileInPlace(moments, SLICE_MOMENT_QUANTILE) : median(std::move(moments));
+  const double spread = median(moments);
+  if (!raw)
+    return BranchMoments{spread, spread};
+  removeTaper(slices);
+  for (std::size_t k = 0; k < slices.size(); ++k)
+    moments[k] = slices[k].moment;
+  return BranchMoments{spread, quantileInPlace(moments, SLICE_MOMENT_QUANTILE)};
 }
 
 /// Centre and length from the used points' extent along the axis, and their mean |d - r|.
@@ -520,7 +532,8 @@ void finishThinCylinder(const Points& pts, const std::vector<int>& used, Cylinde
 
 std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
                                         double sigma, double scatter, double max_radius,
-                                        std::uint64_t seed, std::vector<int>* inliers) {
+                                        std::uint64_t seed, std::vector<int>* inliers,
+                                        double* spread_radius) {
   if (pts.size() < MIN_THIN_POINTS)
     return std::nullopt;
   const double band = max_radius + std::max(noiseBand(sigma), 0.004);
@@ -529,11 +542,12 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   if (best.size() < MIN_THIN_POINTS)
     return std::nullopt;
   // Robust re-centring: per slice the centroid of the points within radius + 2.5 sigma of the
-  // current axis, a line through the slice centroids, the radius from the median of the
-  // slices' second moments about the axis bent through those centroids, less the noise. A parallel
-  // shoot or a spur moves a least-squares cylinder, not this.
+  // current axis, a line through the slice centroids, the radius from the slices' second
+  // moments about the axis bent through those centroids (sliceMoments), less the scatter. A
+  // parallel shoot or a spur moves a least-squares cylinder, not this. The points and the
+  // centre follow the moments' spread, as the shoots belong to the branch taken out.
   std::vector<int> used;
-  double radius = max_radius;
+  double radius = max_radius, wood_radius = max_radius;
   for (int round = 0; round < 5; ++round) {
     // The moment must see the whole scatter it then subtracts.
     const double reach = radius + noiseBand(std::max(sigma, scatter)) + 0.002;
@@ -546,20 +560,27 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
         scatter > 0.0 ? radius : std::sqrt(std::max(0.0, radius * radius - sigma * sigma));
     if (round > 0 && wood >= ARC_MIN_SIGMAS * std::max(sigma, scatter))
       bent.centreOnArc(pts, used, radius);
-    const auto moment = sliceMoment(pts, used, cyl, bent, reach, scatter);
-    if (!moment)
+    const auto moments = sliceMoments(pts, used, cyl, bent, reach, scatter);
+    if (!moments)
       return std::nullopt;
     // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
     // it may exceed the radius bound by the scatter it carries.
     const double upper =
         scatter > 0.0 ? max_radius : max_radius + noiseBand(std::max(sigma, 0.004)) + 0.002;
-    radius =
-        std::clamp(std::sqrt(std::max(0.0, *moment - scatter * scatter)), MIN_THIN_RADIUS_M, upper);
+    const auto toRadius = [&](double moment) {
+      return std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_THIN_RADIUS_M,
+                        upper);
+    };
+    radius = toRadius(moments->spread);
+    wood_radius = toRadius(moments->wood);
   }
   cyl.radius = radius;
   finishThinCylinder(pts, used, &cyl);
+  cyl.radius = wood_radius;
   if (inliers)
     *inliers = used;
+  if (spread_radius)
+    *spread_radius = radius;
   return cyl;
 }
 

@@ -231,10 +231,13 @@ TEST(Cylinder, ThinRawRadiusLeavesShootsOut) {
   add(0.08, 1.0, 40.0, 0.0025, 0.15, 34);
   add(0.18, 3.0, 40.0, 0.0025, 0.15, 35);
   const auto clean = fitThinCylinder(bare, axis, sigma, 0.0, 0.03, 1);
-  const auto with_shoots = fitThinCylinder(shoots, axis, sigma, 0.0, 0.03, 1);
+  double spread = 0.0;
+  const auto with_shoots = fitThinCylinder(shoots, axis, sigma, 0.0, 0.03, 1, nullptr, &spread);
   ASSERT_TRUE(clean && with_shoots);
   EXPECT_GE(with_shoots->radius, clean->radius);
   EXPECT_LT(with_shoots->radius - clean->radius, 0.0006);
+  // Taking the branch out of its cluster takes its shoots' share too.
+  EXPECT_GT(spread, clean->radius + 0.001);
 }
 
 /// A rod along x from r0 to r1 (m) over `length`, returns displaced across its surface.

@@ -123,12 +123,18 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 /// centroids; a branch 2 sigmas thicker than the noise is centred on the circle its
 /// cross-sections lie on instead (a one-sided view pulls the centroids towards the scanner).
 /// @param sigma range noise: sets the bands (m)
-/// @param scatter total scatter removed from the moment (noise and beam spread); 0: the raw
-///        RMS distance from the axis, which may exceed max_radius by the scatter (m)
+/// @param scatter total scatter removed from the moment (noise and beam spread), the median
+///        over slices; 0: the raw RMS distance from the axis, a low quantile over slices with
+///        the taper taken out (shoots and spurs left out), which may exceed max_radius by the
+///        scatter (m)
 /// @param inliers set to the indices of the points used for the radius
+/// @param spread_radius set to the radius the points spread over, shoots and spurs included
+///        (the median over slices; equal to the radius with a scatter to remove): what taking
+///        the branch out of its cluster must take (m)
 std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d& axis_guess,
                                         double sigma, double scatter, double max_radius,
-                                        std::uint64_t seed, std::vector<int>* inliers = nullptr);
+                                        std::uint64_t seed, std::vector<int>* inliers = nullptr,
+                                        double* spread_radius = nullptr);
 
 /// @brief Range noise from the radial residuals (d - r) of a circle or cylinder fit:
 /// 1.4826 MAD x sqrt(3/2), because a return's radial residual carries on average 2/3 of its
