@@ -281,10 +281,10 @@ std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& n
   return Direction{radial, axis, max_angle};
 }
 
-/// The cylinder of the near part: ours a thin-cylinder fit (its radius through the branch
-/// calibration when there is one), the paper's a RANSAC cylinder.
-/// The branch's cylinder, its radius what its points spread over (shoots and spurs included:
-/// the checks and the extraction work with that), and in *wood_radius the radius it reports.
+/// The cylinder of the near part: ours a thin-cylinder fit (its radii through the branch
+/// calibration when there is one), the paper's a RANSAC cylinder. Its radius is what its
+/// points spread over, shoots and spurs included (the checks and the extraction work with
+/// that); *wood_radius is the radius the branch reports.
 std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& seg,
                                           const Direction& guess, std::vector<int>* inliers,
                                           double* wood_radius) {

@@ -274,6 +274,8 @@ constexpr double ARC_RADIUS_SHARE = 2.0;
 constexpr double SLICE_MOMENT_QUANTILE = 0.3;
 // The taper is a slope fitted to at least this many slices; fewer keep their moments.
 constexpr std::size_t MIN_TAPER_SLICES = 4;
+// Rounds of re-centring and re-measuring a thin cylinder's points.
+constexpr int THIN_FIT_ROUNDS = 5;
 
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
@@ -457,31 +459,26 @@ void removeTaper(std::vector<SliceMoment>& slices) {
   }
 }
 
-/// What a branch's slices measure: the moment its points spread over, and the one its wood
-/// reads (m^2).
-struct BranchMoments {
-  double spread;  ///< the median over slices: sets the fit's reach, so its points
-  double wood;    ///< the radius reported
+/// A branch's slices (of at least MIN_THIN_POINTS points within reach), and the mean of all
+/// its squared distances within reach for when no slice has enough.
+struct BranchSlices {
+  std::vector<SliceMoment> slices;
+  double pooled = 0.0;  ///< m^2
 };
 
-/// The moments over slices (of at least MIN_THIN_POINTS) of the squared distances from the axis
-/// within `reach`, or of all points when no slice has enough; nullopt with fewer than
-/// MIN_THIN_POINTS. With a scatter to remove, both are the median of the slices' moments.
-/// Without (a raw moment, for a table or a calibration to map), shoots and spurs are left out
-/// of the wood: each slice's farthest fifth, and the slices they cross, by taking
-/// SLICE_MOMENT_QUANTILE of the moments with the taper removed. The tables absorb what that
-/// takes from the scatter.
-std::optional<BranchMoments> sliceMoments(const Points& pts, const std::vector<int>& used,
-                                          const Cylinder& cyl, const BentAxis& bent, double reach,
-                                          double scatter) {
-  const bool raw = scatter <= 0.0;
+/// The moments of the slices of the squared distances from the axis within `reach`; nullopt
+/// with fewer than MIN_THIN_POINTS. Without a scatter to remove (a raw moment, for a table or a
+/// calibration to map) each slice's farthest fifth is left out: spurs and shoots on the branch.
+std::optional<BranchSlices> sliceMoments(const Points& pts, const std::vector<int>& used,
+                                         const Cylinder& cyl, const BentAxis& bent, double reach,
+                                         bool raw) {
   std::map<long, std::vector<double>> sq_by_slice;
   for (const int i : used) {
     const double dist = bent.distance(pts[i]);
     if (dist < reach)
       sq_by_slice[thinSlice(cyl, pts[i])].push_back(dist * dist);
   }
-  std::vector<SliceMoment> slices;
+  BranchSlices out;
   double total = 0.0;
   int total_n = 0;
   for (auto& [index, v] : sq_by_slice) {
@@ -496,22 +493,36 @@ std::optional<BranchMoments> sliceMoments(const Points& pts, const std::vector<i
     total += sum;
     total_n += static_cast<int>(keep);
     if (static_cast<int>(keep) >= MIN_THIN_POINTS)
-      slices.push_back({static_cast<double>(index), sum / keep});
+      out.slices.push_back({static_cast<double>(index), sum / keep});
   }
   if (total_n < MIN_THIN_POINTS)
     return std::nullopt;
-  if (slices.empty())
-    return BranchMoments{total / total_n, total / total_n};
+  out.pooled = total / total_n;
+  return out;
+}
+
+/// The moment the branch's points spread over, shoots and spurs included: the median over its
+/// slices. It sets the fit's reach, and so its points.
+double spreadMoment(const BranchSlices& b) {
+  if (b.slices.empty())
+    return b.pooled;
   std::vector<double> moments;
-  for (const auto& sl : slices)
+  for (const auto& sl : b.slices)
     moments.push_back(sl.moment);
-  const double spread = median(moments);
-  if (!raw)
-    return BranchMoments{spread, spread};
-  removeTaper(slices);
-  for (std::size_t k = 0; k < slices.size(); ++k)
-    moments[k] = slices[k].moment;
-  return BranchMoments{spread, quantileInPlace(moments, SLICE_MOMENT_QUANTILE)};
+  return median(std::move(moments));
+}
+
+/// The moment the branch's wood reads, for a table or a calibration to map: shoots and spurs
+/// are left out of it by taking SLICE_MOMENT_QUANTILE of the slices' moments with the taper
+/// removed. The tables absorb what that takes from the scatter.
+double woodMoment(BranchSlices b) {
+  if (b.slices.empty())
+    return b.pooled;
+  removeTaper(b.slices);
+  std::vector<double> moments;
+  for (const auto& sl : b.slices)
+    moments.push_back(sl.moment);
+  return quantileInPlace(moments, SLICE_MOMENT_QUANTILE);
 }
 
 /// Centre and length from the used points' extent along the axis, and their mean |d - r|.
@@ -548,7 +559,15 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   // centre follow the moments' spread, as the shoots belong to the branch taken out.
   std::vector<int> used;
   double radius = max_radius, wood_radius = max_radius;
-  for (int round = 0; round < 5; ++round) {
+  const bool raw = scatter <= 0.0;
+  // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it): it
+  // may exceed the radius bound by the scatter it carries.
+  const double upper = raw ? max_radius + noiseBand(std::max(sigma, 0.004)) + 0.002 : max_radius;
+  const auto toRadius = [&](double moment) {
+    return std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_THIN_RADIUS_M,
+                      upper);
+  };
+  for (int round = 0; round < THIN_FIT_ROUNDS; ++round) {
     // The moment must see the whole scatter it then subtracts.
     const double reach = radius + noiseBand(std::max(sigma, scatter)) + 0.002;
     used = recentre(pts, best, axis_guess, reach, &cyl);
@@ -556,23 +575,17 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
       return std::nullopt;
     BentAxis bent(pts, used, cyl);
     // A raw radius still carries the noise.
-    const double wood =
-        scatter > 0.0 ? radius : std::sqrt(std::max(0.0, radius * radius - sigma * sigma));
-    if (round > 0 && wood >= ARC_MIN_SIGMAS * std::max(sigma, scatter))
+    const double noiseless =
+        raw ? std::sqrt(std::max(0.0, radius * radius - sigma * sigma)) : radius;
+    if (round > 0 && noiseless >= ARC_MIN_SIGMAS * std::max(sigma, scatter))
       bent.centreOnArc(pts, used, radius);
-    const auto moments = sliceMoments(pts, used, cyl, bent, reach, scatter);
-    if (!moments)
+    const auto slices = sliceMoments(pts, used, cyl, bent, reach, raw);
+    if (!slices)
       return std::nullopt;
-    // Without a scatter to remove, the raw RMS distance is wanted (a calibration maps it):
-    // it may exceed the radius bound by the scatter it carries.
-    const double upper =
-        scatter > 0.0 ? max_radius : max_radius + noiseBand(std::max(sigma, 0.004)) + 0.002;
-    const auto toRadius = [&](double moment) {
-      return std::clamp(std::sqrt(std::max(0.0, moment - scatter * scatter)), MIN_THIN_RADIUS_M,
-                        upper);
-    };
-    radius = toRadius(moments->spread);
-    wood_radius = toRadius(moments->wood);
+    radius = toRadius(spreadMoment(*slices));
+    // The reported radius is the last round's; with a scatter to remove it is the spread.
+    if (round + 1 == THIN_FIT_ROUNDS)
+      wood_radius = raw ? toRadius(woodMoment(*slices)) : radius;
   }
   cyl.radius = radius;
   finishThinCylinder(pts, used, &cyl);
