@@ -1,5 +1,6 @@
 #include "dormant_tree_modeling/calibration/rig_calibration.h"
 
+#include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -36,6 +37,9 @@ constexpr double SILHOUETTE_VOXEL_M = 0.02;
 constexpr double SILHOUETTE_NEAR_ROD_M = 0.05;
 constexpr double SILHOUETTE_OUTLIER_SIGMAS = 2.5;
 constexpr double MIN_RANGE_SPREAD_M = 0.2;  // narrower: the growth is taken as constant
+// Rods this alike (standard deviation of their diameters) cannot show how the width follows
+// the diameter: the gain is taken as 1.
+constexpr double MIN_DIAMETER_SPREAD_M = 0.002;
 constexpr double MAX_DEPTH_SHARE = 1.5;
 constexpr int DEPTH_SHARE_STEPS = 7;  // 1.5 / 2^7: about 1 % of the growth
 
@@ -378,10 +382,10 @@ std::vector<StationPoints> rigStations(const RigScan& scan, int rig_index) {
 }
 
 /// Each axis sample on a rod, as the registration estimates it with `axes`: its range, its
-/// silhouette's growth (twice its radius less the rod's diameter, meaningful with no growth
-/// taken off) and its depth error (signed, towards the sensor: m).
+/// silhouette's width (twice its radius, meaningful with no growth taken off), the rod's
+/// diameter and the sample's depth error (signed, towards the sensor: m).
 struct AxisSampleOnRod {
-  double range, growth, depth_error;
+  double range, width, diameter, depth_error;
 };
 
 std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& stations,
@@ -402,16 +406,44 @@ std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& sta
       const Eigen::Vector3d off = w - w.dot(dir) * dir;
       Eigen::Vector3d towards = axes.view_dirs[i] - axes.view_dirs[i].dot(dir) * dir;
       towards.normalize();
-      out.push_back(
-          {axes.ranges[i], 2.0 * axes.radii[i] - rod.diameters.front(), off.dot(towards)});
+      out.push_back({axes.ranges[i], 2.0 * axes.radii[i], rod.diameters.front(), off.dot(towards)});
     }
   }
   return out;
 }
 
-/// growth = a + b range by least squares, refitted without the samples beyond 2.5 robust
-/// sigmas of the first fit; b = 0 when the ranges hardly vary.
-modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOnRod>& samples) {
+/// The silhouette model width = gain x diameter + a + b range, by least squares over the
+/// samples within 2.5 robust sigmas of a first fit. b = 0 when the ranges hardly vary, gain = 1
+/// when the rods' diameters do (the footprint then only adds a margin).
+struct GrowthModel {
+  bool per_range, per_diameter;
+
+  Eigen::VectorXd terms(const AxisSampleOnRod& g) const {
+    Eigen::VectorXd x(1 + per_range + per_diameter);
+    x(0) = 1.0;
+    if (per_range)
+      x(1) = g.range;
+    if (per_diameter)
+      x(x.size() - 1) = g.diameter;
+    return x;
+  }
+  double target(const AxisSampleOnRod& g) const {
+    return per_diameter ? g.width : g.width - g.diameter;
+  }
+};
+
+double spread(const std::vector<AxisSampleOnRod>& samples, double AxisSampleOnRod::*field) {
+  double n = 0, s = 0, ss = 0;
+  for (const auto& g : samples) {
+    n += 1;
+    s += g.*field;
+    ss += g.*field * g.*field;
+  }
+  return std::sqrt(std::max(ss / n - (s / n) * (s / n), 0.0));
+}
+
+modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOnRod>& samples,
+                                                  std::vector<std::string>* warnings) {
   modeling::SensorCalibration::Silhouette s;
   s.measured = true;
   std::vector<double> r;
@@ -419,28 +451,52 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOn
     r.push_back(g.range);
   s.range_min_m = *std::min_element(r.begin(), r.end());
   s.range_max_m = *std::max_element(r.begin(), r.end());
+  const GrowthModel model{spread(samples, &AxisSampleOnRod::range) > MIN_RANGE_SPREAD_M,
+                          spread(samples, &AxisSampleOnRod::diameter) > MIN_DIAMETER_SPREAD_M};
   std::vector<char> keep(samples.size(), 1);
+  Eigen::VectorXd p;
   for (int round = 0; round < 2; ++round) {
-    double n = 0, sr = 0, sg = 0, srr = 0, srg = 0;
+    const int k = 1 + model.per_range + model.per_diameter;
+    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(k, k);
+    Eigen::VectorXd atb = Eigen::VectorXd::Zero(k);
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (!keep[i])
         continue;
-      n += 1;
-      sr += samples[i].range;
-      sg += samples[i].growth;
-      srr += samples[i].range * samples[i].range;
-      srg += samples[i].range * samples[i].growth;
+      const Eigen::VectorXd x = model.terms(samples[i]);
+      ata += x * x.transpose();
+      atb += x * model.target(samples[i]);
     }
-    const double var = srr / n - (sr / n) * (sr / n);
-    s.growth_per_m =
-        var > MIN_RANGE_SPREAD_M * MIN_RANGE_SPREAD_M ? (srg / n - sr / n * sg / n) / var : 0.0;
-    s.growth_m = sg / n - s.growth_per_m * sr / n;
+    p = ata.ldlt().solve(atb);
     std::vector<double> residuals;
     for (const auto& g : samples)
-      residuals.push_back(std::abs(g.growth - s.growth_m - s.growth_per_m * g.range));
+      residuals.push_back(std::abs(model.target(g) - model.terms(g).dot(p)));
     const double sigma = 1.4826 * median(residuals);
     for (std::size_t i = 0; i < samples.size(); ++i)
       keep[i] = residuals[i] <= SILHOUETTE_OUTLIER_SIGMAS * sigma;
+  }
+  s.growth_m = p(0);
+  s.growth_per_m = model.per_range ? p(1) : 0.0;
+  s.diameter_gain = model.per_diameter ? p(p.size() - 1) : 1.0;
+  if (!(s.diameter_gain >= modeling::MIN_DIAMETER_GAIN &&
+        s.diameter_gain <= modeling::MAX_DIAMETER_GAIN)) {
+    const double gain =
+        std::clamp(s.diameter_gain, modeling::MIN_DIAMETER_GAIN, modeling::MAX_DIAMETER_GAIN);
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "the silhouettes' width grows by %.2f of the rods' diameter, outside %s: taken "
+                  "as %.2f; the registration's branch radii will be poor",
+                  s.diameter_gain, modeling::diameterGainRange().c_str(), gain);
+    warnings->push_back(text);
+    // The margin is refitted for the held gain, so widths stay unbiased at the rods' mean.
+    double mean_d = 0, mean_w = 0, mean_r = 0;
+    for (const auto& g : samples) {
+      mean_d += g.diameter;
+      mean_w += g.width;
+      mean_r += g.range;
+    }
+    const double n = static_cast<double>(samples.size());
+    s.growth_m = (mean_w - gain * mean_d - s.growth_per_m * mean_r) / n;
+    s.diameter_gain = gain;
   }
   return s;
 }
@@ -456,6 +512,7 @@ double depthShare(const std::vector<StationPoints>& stations,
     registration::AxisConfig c;
     c.silhouette_growth_m = share * growth.growth_m;
     c.silhouette_growth_per_m = share * growth.growth_per_m;
+    c.silhouette_diameter_gain = growth.diameter_gain;
     std::vector<double> e;
     for (const auto& s : samplesOnRods(stations, rigs, search, c))
       e.push_back(s.depth_error);
@@ -568,7 +625,7 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   c.branch_footprint = footprintTable(result.samples, false, rows);
   const auto silhouette = samplesOnRods(stations, rigs, search, registration::AxisConfig{});
   if (silhouette.size() >= static_cast<std::size_t>(search.min_silhouette_samples)) {
-    c.silhouette = fitGrowth(silhouette);
+    c.silhouette = fitGrowth(silhouette, &result.warnings);
     c.silhouette.depth_share = depthShare(stations, rigs, search, c.silhouette);
   } else {
     result.warnings.push_back(

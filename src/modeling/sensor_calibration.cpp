@@ -158,7 +158,8 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   std::tie(c.coverage.noise_min_m, c.coverage.noise_max_m) = range(covers, "noise_m", path);
   if (root["silhouette"]) {
     const YAML::Node s =
-        section(root, "silhouette", {"growth_m", "growth_per_m", "ranges_m", "depth_share"}, path);
+        section(root, "silhouette",
+                {"growth_m", "growth_per_m", "ranges_m", "depth_share", "diameter_gain"}, path);
     const auto growth = numbers(s, "growth_m", "silhouette", path);
     const auto per_m = numbers(s, "growth_per_m", "silhouette", path);
     const auto ranges = numbers(s, "ranges_m", "silhouette", path);
@@ -172,10 +173,22 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
         s["depth_share"] ? numbers(s, "depth_share", "silhouette", path) : std::vector<double>{1.0};
     if (share.size() != 1 || !(share[0] >= 0.0 && share[0] <= 2.0))
       fail(ErrorCode::INVALID_ARGUMENT, path, "silhouette: depth_share is [one number] in [0, 2]");
-    c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1], share[0]};
+    // Files written before the gain was measured assumed 1: the footprint only adds a margin.
+    const auto gain = s["diameter_gain"] ? numbers(s, "diameter_gain", "silhouette", path)
+                                         : std::vector<double>{1.0};
+    if (gain.size() != 1 || !(gain[0] >= MIN_DIAMETER_GAIN && gain[0] <= MAX_DIAMETER_GAIN))
+      fail(ErrorCode::INVALID_ARGUMENT, path,
+           "silhouette: diameter_gain is [one number] in " + diameterGainRange());
+    c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1], share[0], gain[0]};
   }
   c.hash = fnv1aHex(text.str());
   return c;
+}
+
+std::string diameterGainRange() {
+  char text[48];
+  std::snprintf(text, sizeof(text), "[%g, %g]", MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN);
+  return text;
 }
 
 std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::string& comment) {
@@ -199,7 +212,8 @@ std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::strin
     s << "  silhouette:\n    growth_m: " << list({c.silhouette.growth_m})
       << "\n    growth_per_m: " << list({c.silhouette.growth_per_m})
       << "\n    ranges_m: " << list({c.silhouette.range_min_m, c.silhouette.range_max_m})
-      << "\n    depth_share: " << list({c.silhouette.depth_share}) << "\n";
+      << "\n    depth_share: " << list({c.silhouette.depth_share})
+      << "\n    diameter_gain: " << list({c.silhouette.diameter_gain}) << "\n";
   }
   return s.str();
 }

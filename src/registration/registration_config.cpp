@@ -161,6 +161,10 @@ void AxisConfig::validate() const {
   axisConfigTable().require(
       std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
       "silhouette growth (from the calibration) must be within ±0.05 m and ±0.05 m per m");
+  axisConfigTable().require(silhouette_diameter_gain >= modeling::MIN_DIAMETER_GAIN &&
+                                silhouette_diameter_gain <= modeling::MAX_DIAMETER_GAIN,
+                            "silhouette diameter gain (from the calibration) must be within " +
+                                modeling::diameterGainRange());
 }
 
 void RegistrationConfig::validate() const {
@@ -184,6 +188,7 @@ bool applySensorCalibration(const modeling::SensorCalibration& calibration,
   const auto& s = calibration.silhouette;
   config.axes.silhouette_growth_m = s.depth_share * s.growth_m;
   config.axes.silhouette_growth_per_m = s.depth_share * s.growth_per_m;
+  config.axes.silhouette_diameter_gain = s.diameter_gain;
   return true;
 }
 

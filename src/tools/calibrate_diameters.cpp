@@ -51,10 +51,11 @@ void printSamples(const calibration::RigCalibrationResult& result) {
   const auto& s = result.calibration.silhouette;
   if (s.measured) {
     std::snprintf(line, sizeof(line),
-                  "silhouette growth: %.2f mm + %.2f mm per m of range (rods seen at %.2f-%.2f "
-                  "m); the registration takes %.2f of it off for the axes' depth\n",
-                  1000 * s.growth_m, 1000 * s.growth_per_m, s.range_min_m, s.range_max_m,
-                  s.depth_share);
+                  "silhouette width: %.2f x the diameter + %.2f mm + %.2f mm per m of range "
+                  "(rods seen at %.2f-%.2f m); the registration takes %.2f of the margin off for "
+                  "the axes' depth\n",
+                  s.diameter_gain, 1000 * s.growth_m, 1000 * s.growth_per_m, s.range_min_m,
+                  s.range_max_m, s.depth_share);
     std::cerr << line;
   }
 }

@@ -163,6 +163,55 @@ TEST(BranchAxes, SkipPlanesTrunksAndMixedSides) {
   EXPECT_LT(offAxis(STICKS.front(), w.points[0]), 0.0015);
 }
 
+// A wide beam: every silhouette gains wings at the branch's edge range until it is
+// 0.4 x the diameter + 30 mm wide, so a 10 mm and a 40 mm branch look 34 and 46 mm wide.
+HalfView wideBeamHalf(const Stick& s, const Eigen::Vector3d& sensor) {
+  constexpr double GAIN = 0.4, MARGIN = 0.03;
+  HalfView v = seeHalves({s}, sensor, 0, 1);
+  const double half_width = 0.5 * (GAIN * 2 * s.radius + MARGIN);
+  const Eigen::Vector3d a = s.axis.normalized();
+  const Eigen::Vector3d to_sensor = sensor - s.centre;
+  const Eigen::Vector3d depth = (to_sensor - to_sensor.dot(a) * a).normalized();
+  const Eigen::Vector3d across = a.cross(depth);
+  for (const double side : {1.0, -1.0}) {
+    for (double x = s.radius + 0.0015; x <= half_width; x += 0.003) {
+      for (double t = -s.length / 2; t <= s.length / 2; t += 0.004) {
+        const Eigen::Vector3d p = s.centre + t * a + side * x * across;
+        v.points.push_back(p);
+        v.view_dirs.push_back((sensor - p).normalized());
+        v.ranges.push_back((sensor - p).norm());
+      }
+    }
+  }
+  return v;
+}
+
+TEST(BranchAxes, AWideBeamsRadiusDividesByTheDiameterGain) {
+  AxisConfig wide;  // the calibration of that beam: gain 0.4, 30 mm
+  wide.silhouette_growth_m = 0.03;
+  wide.silhouette_diameter_gain = 0.4;
+  AxisConfig margin_only = wide;  // the same beam taken as a margin fitted at 25 mm across
+  margin_only.silhouette_diameter_gain = 1.0;
+  margin_only.silhouette_growth_m = 0.03 - 0.6 * 0.025;
+  for (const double radius : {0.005, 0.02}) {
+    const Stick stick{{0.0, 0.0, 1.5}, {1, 0, 0}, radius, 0.5};
+    const HalfView v = wideBeamHalf(stick, {0.0, -2.0, 1.5});
+    const AxisSamples a = estimateAxes(v.points, v.view_dirs, v.ranges, {stick.centre}, wide);
+    ASSERT_EQ(a.size(), 1u) << radius;
+    EXPECT_NEAR(a.radii[0], radius, 0.001);
+    EXPECT_LT(offAxis(stick, a.points[0]), 0.0015);
+    // With the gain taken as 1 the thin branch reads 4.5 mm thick too, the thick one 4.5 mm
+    // thin, and the axes sit that far off along the rays.
+    const AxisSamples m =
+        estimateAxes(v.points, v.view_dirs, v.ranges, {stick.centre}, margin_only);
+    ASSERT_EQ(m.size(), 1u) << radius;
+    EXPECT_GT(std::abs(m.radii[0] - radius), 0.004);
+  }
+  AxisConfig bad = wide;
+  bad.silhouette_diameter_gain = 0.05;
+  EXPECT_THROW(bad.validate(), Error);
+}
+
 TEST(BranchAxes, RejectBadInput) {
   AxisConfig bad;
   bad.silhouette_growth_per_m = 0.5;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <numeric>
 
@@ -112,7 +113,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   c.trunk_footprint.bias = {0.003, 0.001};
   c.branch_footprint = c.trunk_footprint;
   c.coverage = {0.01, 0.05, 0.003, 0.02, 0.006, 0.006};
-  c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4, 0.5};
+  c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4, 0.5, 0.4};
   const std::string path =
       dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "made by a test"));
   const auto back = modeling::loadSensorCalibration(path);
@@ -126,6 +127,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   registration::RegistrationConfig reg;
   EXPECT_TRUE(registration::applySensorCalibration(back, reg));
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.5 * 0.0015);
+  EXPECT_DOUBLE_EQ(reg.axes.silhouette_diameter_gain, 0.4);
   modeling::SensorCalibration without = back;
   without.silhouette = {};
   registration::RegistrationConfig ideal;
@@ -151,6 +153,14 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_EQ(code(replaced("bias_m: [0.00300", "bias_m: [0.30000")), ErrorCode::INVALID_ARGUMENT);
   EXPECT_EQ(code(replaced("covers:", "coverage:")), ErrorCode::PARSE_ERROR);
   EXPECT_EQ(code(replaced("noise_m: [0.00600]", "noise_m: six")), ErrorCode::PARSE_ERROR);
+  // A gain this low would multiply the width's noise tenfold into the radius.
+  EXPECT_EQ(code(replaced("diameter_gain: [0.40000]", "diameter_gain: [0.10000]")),
+            ErrorCode::INVALID_ARGUMENT);
+  // Files from before the gain was measured: the footprint only adds a margin.
+  EXPECT_DOUBLE_EQ(modeling::loadSensorCalibration(
+                       dir.write("old.yaml", replaced("\n    diameter_gain: [0.40000]", "")))
+                       .silhouette.diameter_gain,
+                   1.0);
   EXPECT_THROW(modeling::loadSensorCalibration(dir.file("missing.yaml")), Error);
   // Another file, another hash.
   EXPECT_NE(
@@ -241,11 +251,18 @@ TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
   const auto& s = r.calibration.silhouette;
   ASSERT_TRUE(s.measured);
   // Our sensor model's beam: 8 mm + 15 mrad, 38 mm across at 2 m; a beam a few tenths on a rod
-  // still returns with the rod's range, so at 2 m the silhouette grows by about half of that.
-  const double at_2m = s.growth_m + 2.0 * s.growth_per_m;
+  // still returns with the rod's range, so at 2 m a 10 mm rod's silhouette grows by about half
+  // of that.
+  const double at_2m = s.growth_m + 2.0 * s.growth_per_m - (1.0 - s.diameter_gain) * 0.01;
   EXPECT_GT(at_2m, 0.010);
   EXPECT_LT(at_2m, 0.030);
   EXPECT_GT(s.growth_per_m, 0.0);
+  // A beam that wide also lets a thin rod catch more of it than a thick one gains: the width
+  // follows the diameter only in part.
+  EXPECT_GT(s.diameter_gain, 0.5);
+  EXPECT_LT(s.diameter_gain, 0.95);
+  std::printf("[ INFO ] width %.2f x diameter + %.2f mm + %.2f mm/m, share %.2f\n", s.diameter_gain,
+              1000 * s.growth_m, 1000 * s.growth_per_m, s.depth_share);
   EXPECT_LT(s.range_min_m, 1.6);
   // The wings carry the near surface's range: the axes' depth wants part of the growth only.
   EXPECT_GT(s.depth_share, 0.3);

@@ -17,6 +17,15 @@ struct CalibrationCoverage {
   double noise_min_m = 0.0, noise_max_m = 0.0;
 };
 
+/// @brief The range of a silhouette's diameter gain (SensorCalibration::Silhouette). Below
+/// the minimum a width tells diameters apart too little: a radius read from it would carry
+/// more than 5 times the width's noise.
+constexpr double MIN_DIAMETER_GAIN = 0.2;
+constexpr double MAX_DIAMETER_GAIN = 1.5;
+
+/// @brief "[min, max]" of the diameter gain, for messages.
+std::string diameterGainRange();
+
 /// @brief The part of one scanner's radius bias that range noise does not explain: the beam
 /// footprint's widening of thin objects (apparent minus true radius, m, over the true radius
 /// and the estimated noise, after the noise part of noise_bias.h is taken off). Made by
@@ -28,9 +37,9 @@ struct SensorCalibration {
   RadiusCalibration trunk_footprint;   ///< of the trunk step's slice radius
   RadiusCalibration branch_footprint;  ///< of the branch step's raw radius
   CalibrationCoverage coverage;
-  /// How much wider than its diameter a thin branch's one-sided silhouette looks, over the
-  /// range: growth_m + growth_per_m x range (m), for the registration's branch axes. Measured
-  /// when the rig was given as views (calibrate_diameters --scan DIR); absent otherwise.
+  /// How wide a thin branch's one-sided silhouette looks, for the registration's branch axes:
+  /// diameter_gain x diameter + growth_m + growth_per_m x range (m). Measured when the rig was
+  /// given as views (calibrate_diameters --scan DIR); absent otherwise.
   struct Silhouette {
     bool measured = false;
     double growth_m = 0.0, growth_per_m = 0.0;
@@ -38,6 +47,10 @@ struct SensorCalibration {
     /// The share of the growth the registration takes off a silhouette so that its axes lie
     /// at the rods' depth (the footprint's wings carry the near surface's range).
     double depth_share = 1.0;
+    /// How much of a diameter change the silhouette's width shows: 1 where the footprint only
+    /// adds a margin; well below 1 where a wide beam's footprint makes thin and thick branches
+    /// look alike (a radius read from the width then divides by it).
+    double diameter_gain = 1.0;
   } silhouette;
   std::vector<std::string> sources;  ///< the scans it was made from, for the record
 

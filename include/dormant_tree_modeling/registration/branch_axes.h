@@ -35,6 +35,9 @@ struct AxisConfig {
   /// views). 0 and 0: an ideal beam.
   double silhouette_growth_m = 0.0;
   double silhouette_growth_per_m = 0.0;
+  /// How much of a diameter change the width shows (the calibration's diameter_gain): the
+  /// radius is half the width less the growth, divided by it. 1: an ideal beam's.
+  double silhouette_diameter_gain = 1.0;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };
