@@ -412,9 +412,9 @@ std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& sta
   return out;
 }
 
-/// The silhouette model width = gain x diameter + a + b range, by least squares over the
-/// samples within 2.5 robust sigmas of a first fit. b = 0 when the ranges hardly vary, gain = 1
-/// when the rods' diameters do (the footprint then only adds a margin).
+/// The terms of the silhouette model width = gain x diameter + a + b range that the rods can
+/// measure: the margin a always, b when their ranges vary, the gain when their diameters do
+/// (else it is 1: the footprint only adds a margin, and the target is the width less it).
 struct GrowthModel {
   bool per_range, per_diameter;
 
@@ -432,6 +432,7 @@ struct GrowthModel {
   }
 };
 
+/// The standard deviation of one field over the samples.
 double spread(const std::vector<AxisSampleOnRod>& samples, double AxisSampleOnRod::*field) {
   double n = 0, s = 0, ss = 0;
   for (const auto& g : samples) {
@@ -442,6 +443,32 @@ double spread(const std::vector<AxisSampleOnRod>& samples, double AxisSampleOnRo
   return std::sqrt(std::max(ss / n - (s / n) * (s / n), 0.0));
 }
 
+/// Holds a gain the rods put outside [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] at the bound, with
+/// a warning, and refits the margin for it so that widths stay unbiased at the rods' mean.
+void holdGain(const std::vector<AxisSampleOnRod>& samples,
+              modeling::SensorCalibration::Silhouette& s, std::vector<std::string>* warnings) {
+  const double gain =
+      std::clamp(s.diameter_gain, modeling::MIN_DIAMETER_GAIN, modeling::MAX_DIAMETER_GAIN);
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "the silhouettes' width grows by %.2f of the rods' diameter, outside %s: taken "
+                "as %.2f; the registration's branch radii will be poor",
+                s.diameter_gain, modeling::diameterGainRange().c_str(), gain);
+  warnings->push_back(text);
+  double sum_d = 0, sum_w = 0, sum_r = 0;
+  for (const auto& g : samples) {
+    sum_d += g.diameter;
+    sum_w += g.width;
+    sum_r += g.range;
+  }
+  s.growth_m =
+      (sum_w - gain * sum_d - s.growth_per_m * sum_r) / static_cast<double>(samples.size());
+  s.diameter_gain = gain;
+}
+
+/// The silhouette model by least squares, refitted without the samples beyond 2.5 robust
+/// sigmas of the first fit. A gain outside [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] is held at
+/// the bound, with a warning.
 modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOnRod>& samples,
                                                   std::vector<std::string>* warnings) {
   modeling::SensorCalibration::Silhouette s;
@@ -478,26 +505,8 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOn
   s.growth_per_m = model.per_range ? p(1) : 0.0;
   s.diameter_gain = model.per_diameter ? p(p.size() - 1) : 1.0;
   if (!(s.diameter_gain >= modeling::MIN_DIAMETER_GAIN &&
-        s.diameter_gain <= modeling::MAX_DIAMETER_GAIN)) {
-    const double gain =
-        std::clamp(s.diameter_gain, modeling::MIN_DIAMETER_GAIN, modeling::MAX_DIAMETER_GAIN);
-    char text[160];
-    std::snprintf(text, sizeof(text),
-                  "the silhouettes' width grows by %.2f of the rods' diameter, outside %s: taken "
-                  "as %.2f; the registration's branch radii will be poor",
-                  s.diameter_gain, modeling::diameterGainRange().c_str(), gain);
-    warnings->push_back(text);
-    // The margin is refitted for the held gain, so widths stay unbiased at the rods' mean.
-    double mean_d = 0, mean_w = 0, mean_r = 0;
-    for (const auto& g : samples) {
-      mean_d += g.diameter;
-      mean_w += g.width;
-      mean_r += g.range;
-    }
-    const double n = static_cast<double>(samples.size());
-    s.growth_m = (mean_w - gain * mean_d - s.growth_per_m * mean_r) / n;
-    s.diameter_gain = gain;
-  }
+        s.diameter_gain <= modeling::MAX_DIAMETER_GAIN))
+    holdGain(samples, s, warnings);
   return s;
 }
 
