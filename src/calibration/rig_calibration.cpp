@@ -381,18 +381,13 @@ std::vector<StationPoints> rigStations(const RigScan& scan, int rig_index) {
   return out;
 }
 
-/// Each axis sample on a rod, as the registration estimates it with `axes`: its range, its
-/// silhouette's width (twice its radius, meaningful with no growth taken off), the rod's
-/// diameter and the sample's depth error (signed, towards the sensor: m).
-struct AxisSampleOnRod {
-  double range, width, diameter, depth_error;
-};
-
-std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& stations,
-                                           const std::vector<evaluation::GroundTruth>& rigs,
-                                           const RigSearch& search,
-                                           const registration::AxisConfig& axes_config) {
-  std::vector<AxisSampleOnRod> out;
+/// Each axis sample on a rod, as the registration estimates it with `axes` (the width is
+/// meaningful with no growth taken off).
+std::vector<SilhouetteSample> samplesOnRods(const std::vector<StationPoints>& stations,
+                                            const std::vector<evaluation::GroundTruth>& rigs,
+                                            const RigSearch& search,
+                                            const registration::AxisConfig& axes_config) {
+  std::vector<SilhouetteSample> out;
   for (const auto& s : stations) {
     const evaluation::GroundTruth& rig = rigs[s.rig];
     const auto axes = registration::estimateAxes(s.pts, s.dirs, s.ranges, s.centres, axes_config);
@@ -418,7 +413,7 @@ std::vector<AxisSampleOnRod> samplesOnRods(const std::vector<StationPoints>& sta
 struct GrowthModel {
   bool per_range, per_diameter;
 
-  Eigen::VectorXd terms(const AxisSampleOnRod& g) const {
+  Eigen::VectorXd terms(const SilhouetteSample& g) const {
     Eigen::VectorXd x(1 + per_range + per_diameter);
     x(0) = 1.0;
     if (per_range)
@@ -427,13 +422,13 @@ struct GrowthModel {
       x(x.size() - 1) = g.diameter;
     return x;
   }
-  double target(const AxisSampleOnRod& g) const {
+  double target(const SilhouetteSample& g) const {
     return per_diameter ? g.width : g.width - g.diameter;
   }
 };
 
 /// The standard deviation of one field over the samples.
-double spread(const std::vector<AxisSampleOnRod>& samples, double AxisSampleOnRod::*field) {
+double spread(const std::vector<SilhouetteSample>& samples, double SilhouetteSample::*field) {
   double n = 0, s = 0, ss = 0;
   for (const auto& g : samples) {
     n += 1;
@@ -445,7 +440,7 @@ double spread(const std::vector<AxisSampleOnRod>& samples, double AxisSampleOnRo
 
 /// Holds a gain the rods put outside [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] at the bound, with
 /// a warning, and refits the margin for it so that widths stay unbiased at the rods' mean.
-void holdGain(const std::vector<AxisSampleOnRod>& samples,
+void holdGain(const std::vector<SilhouetteSample>& samples,
               modeling::SensorCalibration::Silhouette& s, std::vector<std::string>* warnings) {
   const double gain =
       std::clamp(s.diameter_gain, modeling::MIN_DIAMETER_GAIN, modeling::MAX_DIAMETER_GAIN);
@@ -466,10 +461,8 @@ void holdGain(const std::vector<AxisSampleOnRod>& samples,
   s.diameter_gain = gain;
 }
 
-/// The silhouette model by least squares, refitted without the samples beyond 2.5 robust
-/// sigmas of the first fit. A gain outside [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] is held at
-/// the bound, with a warning.
-modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOnRod>& samples,
+/// fitSilhouette on samples that are there.
+modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<SilhouetteSample>& samples,
                                                   std::vector<std::string>* warnings) {
   modeling::SensorCalibration::Silhouette s;
   s.measured = true;
@@ -478,8 +471,8 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<AxisSampleOn
     r.push_back(g.range);
   s.range_min_m = *std::min_element(r.begin(), r.end());
   s.range_max_m = *std::max_element(r.begin(), r.end());
-  const GrowthModel model{spread(samples, &AxisSampleOnRod::range) > MIN_RANGE_SPREAD_M,
-                          spread(samples, &AxisSampleOnRod::diameter) > MIN_DIAMETER_SPREAD_M};
+  const GrowthModel model{spread(samples, &SilhouetteSample::range) > MIN_RANGE_SPREAD_M,
+                          spread(samples, &SilhouetteSample::diameter) > MIN_DIAMETER_SPREAD_M};
   std::vector<char> keep(samples.size(), 1);
   Eigen::VectorXd p;
   for (int round = 0; round < 2; ++round) {
@@ -536,6 +529,14 @@ double depthShare(const std::vector<StationPoints>& stations,
 }
 
 }  // namespace
+
+modeling::SensorCalibration::Silhouette fitSilhouette(const std::vector<SilhouetteSample>& samples,
+                                                      std::vector<std::string>* warnings) {
+  if (samples.empty())
+    throw Error(ErrorCode::EMPTY_INPUT, "fitSilhouette: no silhouette samples");
+  std::vector<std::string> unread;
+  return fitGrowth(samples, warnings ? warnings : &unread);
+}
 
 RigScan readRigViews(const std::string& dir, const evaluation::GroundTruth& rig) {
   registration::ViewFolderConfig o;
@@ -634,7 +635,7 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   c.branch_footprint = footprintTable(result.samples, false, rows);
   const auto silhouette = samplesOnRods(stations, rigs, search, registration::AxisConfig{});
   if (silhouette.size() >= static_cast<std::size_t>(search.min_silhouette_samples)) {
-    c.silhouette = fitGrowth(silhouette, &result.warnings);
+    c.silhouette = fitSilhouette(silhouette, &result.warnings);
     c.silhouette.depth_share = depthShare(stations, rigs, search, c.silhouette);
   } else {
     result.warnings.push_back(

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <numeric>
 
 #include "dormant_tree_modeling/calibration/rig_calibration.h"
@@ -167,6 +168,77 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
       modeling::loadSensorCalibration(dir.write("other.yaml", replaced("unit 1234", "unit 99")))
           .hash,
       back.hash);
+}
+
+// Samples on rods of 4-40 mm seen at 1.2-3.0 m whose widths follow width(diameter, range).
+std::vector<calibration::SilhouetteSample> silhouettes(
+    const std::function<double(double, double)>& width) {
+  std::vector<calibration::SilhouetteSample> out;
+  for (const double d : {0.004, 0.006, 0.01, 0.016, 0.025, 0.04}) {
+    for (const double range : {1.2, 1.8, 2.4, 3.0})
+      out.push_back({range, width(d, range), d, 0.0});
+  }
+  return out;
+}
+
+TEST(SilhouetteModel, GainMarginAndSlopeComeBackFromTheRods) {
+  auto wide = [](double d, double range) { return 0.4 * d + 0.024 + 0.008 * range; };
+  std::vector<std::string> warnings;
+  auto s = calibration::fitSilhouette(silhouettes(wide), &warnings);
+  EXPECT_TRUE(s.measured);
+  EXPECT_NEAR(s.diameter_gain, 0.4, 1e-9);
+  EXPECT_NEAR(s.growth_m, 0.024, 1e-9);
+  EXPECT_NEAR(s.growth_per_m, 0.008, 1e-9);
+  EXPECT_DOUBLE_EQ(s.range_min_m, 1.2);
+  EXPECT_DOUBLE_EQ(s.range_max_m, 3.0);
+  EXPECT_TRUE(warnings.empty());
+  // A sample across two rods reads 5 cm wide: the refit leaves it out.
+  auto crossed = silhouettes(wide);
+  for (std::size_t i = 0; i < crossed.size(); i += 10)
+    crossed[i].width += 0.05;
+  s = calibration::fitSilhouette(crossed, &warnings);
+  EXPECT_NEAR(s.diameter_gain, 0.4, 1e-9);
+  EXPECT_NEAR(s.growth_m, 0.024, 1e-9);
+  // Rods of one diameter cannot show the gain: 1, the width less the diameter is the margin.
+  auto one_diameter = silhouettes(wide);
+  for (auto& g : one_diameter) {
+    g.diameter = 0.01;
+    g.width = wide(0.01, g.range);
+  }
+  s = calibration::fitSilhouette(one_diameter, &warnings);
+  EXPECT_DOUBLE_EQ(s.diameter_gain, 1.0);
+  EXPECT_NEAR(s.growth_m, 0.004 + 0.024 - 0.01, 1e-9);
+  EXPECT_NEAR(s.growth_per_m, 0.008, 1e-9);
+  // Seen at one range: no slope, the margin at that range.
+  auto one_range = silhouettes(wide);
+  for (auto& g : one_range) {
+    g.range = 2.0;
+    g.width = wide(g.diameter, 2.0);
+  }
+  s = calibration::fitSilhouette(one_range, &warnings);
+  EXPECT_DOUBLE_EQ(s.growth_per_m, 0.0);
+  EXPECT_NEAR(s.growth_m, 0.024 + 0.016, 1e-9);
+  EXPECT_NEAR(s.diameter_gain, 0.4, 1e-9);
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_THROW(calibration::fitSilhouette({}, &warnings), Error);
+}
+
+TEST(SilhouetteModel, AGainTooLowToReadIsHeldAtTheBoundAndSaid) {
+  // Widths that hardly follow the diameter: a radius read from them would be noise.
+  const auto samples =
+      silhouettes([](double d, double range) { return 0.1 * d + 0.03 + 0.004 * range; });
+  std::vector<std::string> warnings;
+  const auto s = calibration::fitSilhouette(samples, &warnings);
+  EXPECT_DOUBLE_EQ(s.diameter_gain, modeling::MIN_DIAMETER_GAIN);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("0.10 of the rods' diameter"), std::string::npos) << warnings[0];
+  // The margin is refitted for the held gain: the rods' mean width stays where it was.
+  double measured = 0, modelled = 0;
+  for (const auto& g : samples) {
+    measured += g.width;
+    modelled += s.diameter_gain * g.diameter + s.growth_m + s.growth_per_m * g.range;
+  }
+  EXPECT_NEAR(modelled, measured, 1e-9);
 }
 
 TEST(SensorCalibrationFile, OldTablesInTheModelerParametersAreRefusedWithTheWayOut) {

@@ -64,6 +64,25 @@ struct RigSearch {
   int min_silhouette_samples = 20;  ///< fewer: the silhouette is not measured (warned)
 };
 
+/// @brief One branch-axis sample of the registration's estimator on a rig rod (m).
+struct SilhouetteSample {
+  double range = 0.0;        ///< the sample's patch from its sensor
+  double width = 0.0;        ///< the silhouette's width (twice the radius with no growth taken)
+  double diameter = 0.0;     ///< the rod's true diameter
+  double depth_error = 0.0;  ///< of the sample's axis point, signed, towards the sensor
+};
+
+/// @brief The silhouette model width = diameter_gain x diameter + growth_m + growth_per_m x
+/// range by least squares, refitted without the samples beyond 2.5 robust sigmas of the first
+/// fit. growth_per_m is 0 when the ranges spread less than 0.2 m and the gain is 1 when the
+/// diameters spread less than 2 mm (standard deviations); a gain outside
+/// [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] is held at the bound with a warning and the margin
+/// refitted for it. depth_share is left at 1 (calibrateFromRig bisects it on the rods).
+/// @param warnings receives what was held
+/// @throws Error EMPTY_INPUT when there are no samples
+modeling::SensorCalibration::Silhouette fitSilhouette(const std::vector<SilhouetteSample>& samples,
+                                                      std::vector<std::string>* warnings);
+
 /// @brief Measure every rod and pipe section of the rig in each scan with the modeler's own
 /// estimators (the trunk step's slice circles, the branch step's raw radius) and its noise
 /// estimate, take off the noise part (noise_bias.h) and tabulate the rest, the footprint, over
