@@ -497,8 +497,7 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<SilhouetteSa
   s.growth_m = p(0);
   s.growth_per_m = model.per_range ? p(1) : 0.0;
   s.diameter_gain = model.per_diameter ? p(p.size() - 1) : 1.0;
-  if (!(s.diameter_gain >= modeling::MIN_DIAMETER_GAIN &&
-        s.diameter_gain <= modeling::MAX_DIAMETER_GAIN))
+  if (!modeling::validDiameterGain(s.diameter_gain))
     holdGain(samples, s, warnings);
   return s;
 }
@@ -511,12 +510,14 @@ double depthShare(const std::vector<StationPoints>& stations,
                   const std::vector<evaluation::GroundTruth>& rigs, const RigSearch& search,
                   const modeling::SensorCalibration::Silhouette& growth) {
   auto error = [&](double share) {
-    registration::AxisConfig c;
-    c.silhouette_growth_m = share * growth.growth_m;
-    c.silhouette_growth_per_m = share * growth.growth_per_m;
-    c.silhouette_diameter_gain = growth.diameter_gain;
+    // The axes as the registration will estimate them with this share.
+    modeling::SensorCalibration trial;
+    trial.silhouette = growth;
+    trial.silhouette.depth_share = share;
+    registration::RegistrationConfig c;
+    registration::applySensorCalibration(trial, c);
     std::vector<double> e;
-    for (const auto& s : samplesOnRods(stations, rigs, search, c))
+    for (const auto& s : samplesOnRods(stations, rigs, search, c.axes))
       e.push_back(s.depth_error);
     return e.empty() ? 0.0 : median(e);
   };

@@ -176,7 +176,7 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
     // Files written before the gain was measured assumed 1: the footprint only adds a margin.
     const auto gain = s["diameter_gain"] ? numbers(s, "diameter_gain", "silhouette", path)
                                          : std::vector<double>{1.0};
-    if (gain.size() != 1 || !(gain[0] >= MIN_DIAMETER_GAIN && gain[0] <= MAX_DIAMETER_GAIN))
+    if (gain.size() != 1 || !validDiameterGain(gain[0]))
       fail(ErrorCode::INVALID_ARGUMENT, path,
            "silhouette: diameter_gain is [one number] in " + diameterGainRange());
     c.silhouette = {true, growth[0], per_m[0], ranges[0], ranges[1], share[0], gain[0]};

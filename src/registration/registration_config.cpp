@@ -161,8 +161,7 @@ void AxisConfig::validate() const {
   axisConfigTable().require(
       std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
       "silhouette growth (from the calibration) must be within ±0.05 m and ±0.05 m per m");
-  axisConfigTable().require(silhouette_diameter_gain >= modeling::MIN_DIAMETER_GAIN &&
-                                silhouette_diameter_gain <= modeling::MAX_DIAMETER_GAIN,
+  axisConfigTable().require(modeling::validDiameterGain(silhouette_diameter_gain),
                             "silhouette diameter gain (from the calibration) must be within " +
                                 modeling::diameterGainRange());
 }

@@ -23,6 +23,11 @@ struct CalibrationCoverage {
 constexpr double MIN_DIAMETER_GAIN = 0.2;
 constexpr double MAX_DIAMETER_GAIN = 1.5;
 
+/// @brief Whether a diameter gain lies in [MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN] (false for NaN).
+constexpr bool validDiameterGain(double gain) {
+  return gain >= MIN_DIAMETER_GAIN && gain <= MAX_DIAMETER_GAIN;
+}
+
 /// @brief "[min, max]" of the diameter gain, for messages.
 std::string diameterGainRange();
 
