@@ -53,6 +53,19 @@ constexpr int CUT_FILL_MIN_POINTS = 3;
 // Seeds: per candidate, from the modeler's seed and a running stream.
 constexpr std::uint64_t HALVES_SEED_FACTOR = 7757ULL;
 constexpr std::uint64_t FIT_SEED_FACTOR = 15485863ULL;
+constexpr std::uint64_t REFIT_STREAM_START = 1ULL << 32;  // past any tree's fits
+// A primary's axis passes through its trunk: a fit whose axis passes more than FORK_AXIS_GAP
+// outside the trunk surface followed a side arm forking off the branch (a secondary, a shoot at
+// its tip), which leaves the branch at an angle. 96 % of matched primaries pass within it,
+// fits along side arms mostly 25-70 mm off. Between lines near parallel the gap says
+// little: fits within FORK_MIN_TRUNK_ANGLE of the trunk axis (steep scaffolds) are left alone.
+constexpr double FORK_AXIS_GAP = 0.02;  // m
+constexpr double FORK_MIN_TRUNK_ANGLE = 30.0 * DEG;
+// The branch before the fork: the candidate's points within this share of branches.fit_length_m
+// off the trunk surface. The refit along it turns from the side arm's fit by at most
+// FORK_MAX_TURN (a fork's arms part by less; more is another branch).
+constexpr double FORK_BASE_SHARE = 0.5;
+constexpr double FORK_MAX_TURN = 45.0 * DEG;
 
 // A trellis wire: thin, near level, and seen again beyond the trunk on its line.
 constexpr double MAX_WIRE_RADIUS = 0.004;  // m
@@ -66,6 +79,11 @@ constexpr double WIRE_OCCUPIED_SHARE = 0.8;       // of the steps that hold a re
 
 double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+}
+
+/// The angle between two lines (the directions' signs ignored).
+double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(std::abs(a.dot(b)), 0.0, 1.0));
 }
 
 /// Closest points between two lines p + t u and q + s v: returns the distance between the
@@ -86,6 +104,28 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
   if (on_second)
     *on_second = y;
   return (x - y).norm();
+}
+
+/// The widest radius ours allows a branch: its trunk segment's.
+double maxBranchRadius(const Cylinder& seg) {
+  return std::max(MIN_BRANCH_RADIUS * 2, seg.radius);
+}
+
+/// How far a fit's axis passes outside the trunk segment's surface (m; negative: through it).
+double axisGapOutside(const Cylinder& fit, const Cylinder& seg) {
+  return lineGap(fit.center, fit.axis, seg.center, seg.axis, nullptr) - seg.radius;
+}
+
+/// Whether a fit's axis misses the trunk as a side arm's does (FORK_AXIS_GAP).
+bool missesLikeASideArm(const Cylinder& fit, const Cylinder& seg) {
+  return lineAngle(fit.axis, seg.axis) > FORK_MIN_TRUNK_ANGLE &&
+         axisGapOutside(fit, seg) > FORK_AXIS_GAP;
+}
+
+/// Whether a fit's axis leads into the trunk as a primary's does, at a clear angle to it.
+bool leadsIntoTheTrunk(const Cylinder& fit, const Cylinder& seg) {
+  return lineAngle(fit.axis, seg.axis) > FORK_MIN_TRUNK_ANGLE &&
+         axisGapOutside(fit, seg) <= FORK_AXIS_GAP;
 }
 
 /// Whether a fit runs along the row's wires (any direction when none were found).
@@ -193,7 +233,7 @@ bool BranchSearch::budgetLeft() const {
 /// the candidate down), take a wire's points out, keep a branch and search what is left.
 void BranchSearch::examine(const Candidate& candidate) {
   const ModelerConfig& config = context_.config;
-  const NearPart near = nearPart(candidate.members);
+  NearPart near = nearPart(candidate.members, config.branches.fit_length_m);
   if (static_cast<int>(near.pts.size()) < config.branches.min_points)
     return reject(candidate, near.segment, {BranchRejection::TOO_FEW_POINTS, false});
   const Cylinder& seg = context_.trunk.cylinders[near.segment];
@@ -202,11 +242,13 @@ void BranchSearch::examine(const Candidate& candidate) {
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   std::vector<int> inliers;
   double wood_radius = 0.0;
-  auto cyl = fit(near, seg, *guess, &inliers, &wood_radius);
+  auto cyl = fit(near, seg, *guess, nextFitSeed(), &inliers, &wood_radius);
   if (!cyl || static_cast<int>(inliers.size()) < config.branches.min_points)
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   if (cyl->axis.dot(guess->radial) < 0.0)
     cyl->axis = -cyl->axis;
+  if (config.fit.constrain && missesLikeASideArm(*cyl, seg))
+    refitAtFork(candidate, seg, *guess, &near, &*cyl, &inliers, &wood_radius);
   Eigen::Vector3d attachment;
   const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
   bool reaches_surface = true;
@@ -235,7 +277,93 @@ void BranchSearch::examine(const Candidate& candidate) {
   accept(candidate, near, *cyl, wood_radius, inliers, attachment, reaches_surface);
 }
 
-BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) const {
+/// A fit along a side arm forking off a branch (missesLikeASideArm) is replaced by a fit along
+/// the branch: the line the branch takes before the fork (baseFit), and the near part's points
+/// on that line fitted again. The side arm's points stay in the candidate, searched again once
+/// the branch is taken out. Returns whether the fit was replaced: not when the branch's fit
+/// would not lead into the trunk or turns from the first by more than FORK_MAX_TURN.
+bool BranchSearch::refitAtFork(const Candidate& candidate, const Cylinder& seg,
+                               const Direction& guess, NearPart* near, Cylinder* cyl,
+                               std::vector<int>* inliers, double* wood_radius) {
+  const auto base = baseFit(candidate, seg, guess);
+  if (!base)
+    return false;
+  NearPart along = alongLine(*near, *base, *cyl);
+  const int min_points = context_.config.branches.min_points;
+  if (static_cast<int>(along.pts.size()) < min_points)
+    return false;
+  Direction from_base = guess;
+  from_base.axis = base->axis;
+  std::vector<int> in;
+  double wood = 0.0;
+  auto refit = fit(along, seg, from_base, nextRefitSeed(), &in, &wood);
+  if (!refit || static_cast<int>(in.size()) < min_points)
+    return false;
+  if (refit->axis.dot(guess.radial) < 0.0)
+    refit->axis = -refit->axis;
+  if (!leadsIntoTheTrunk(*refit, seg) || lineAngle(refit->axis, cyl->axis) > FORK_MAX_TURN)
+    return false;
+  *near = std::move(along);
+  *cyl = *refit;
+  *inliers = std::move(in);
+  *wood_radius = wood;
+  return true;
+}
+
+/// The fit to the candidate's part before a fork (FORK_BASE_SHARE of the fit length), when its
+/// axis passes through the trunk.
+std::optional<Cylinder> BranchSearch::baseFit(const Candidate& candidate, const Cylinder& seg,
+                                              const Direction& guess) {
+  const ModelerConfig& config = context_.config;
+  const NearPart base = nearPart(candidate.members, FORK_BASE_SHARE * config.branches.fit_length_m);
+  if (static_cast<int>(base.pts.size()) < config.branches.min_points)
+    return std::nullopt;
+  std::vector<int> in;
+  double wood = 0.0;
+  auto b = fit(base, seg, guess, nextRefitSeed(), &in, &wood);
+  if (!b || static_cast<int>(in.size()) < config.branches.min_points)
+    return std::nullopt;
+  if (b->axis.dot(guess.radial) < 0.0)
+    b->axis = -b->axis;
+  if (!leadsIntoTheTrunk(*b, seg))
+    return std::nullopt;
+  return b;
+}
+
+/// The near part's points on a found line (extractionReach) and nearer to it than to the side
+/// arm's: by the fork both lines hold them.
+BranchSearch::NearPart BranchSearch::alongLine(const NearPart& near, const Cylinder& line,
+                                               const Cylinder& side_arm) const {
+  NearPart along;
+  along.segment = near.segment;
+  along.nearest_gap = near.nearest_gap;
+  const double reach = extractionReach(line);
+  for (std::size_t i = 0; i < near.pts.size(); ++i) {
+    const double d = axisDistance(line, near.pts[i]);
+    if (d <= reach && d < axisDistance(side_arm, near.pts[i])) {
+      along.pts.push_back(near.pts[i]);
+      along.index.push_back(near.index[i]);
+    }
+  }
+  return along;
+}
+
+/// How far from a found line's axis its points lie: its radius (what its points spread over),
+/// the noise band and a margin.
+double BranchSearch::extractionReach(const Cylinder& found) const {
+  const BranchBands& bands = context_.bands;
+  return found.radius + noiseBand(std::max(bands.sigma, bands.scatter)) + EXTRACTION_MARGIN;
+}
+
+std::uint64_t BranchSearch::nextFitSeed() {
+  return context_.config.seed * FIT_SEED_FACTOR + stream_++;
+}
+
+std::uint64_t BranchSearch::nextRefitSeed() {
+  return context_.config.seed * FIT_SEED_FACTOR + REFIT_STREAM_START + refit_stream_++;
+}
+
+BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster, double reach) const {
   NearPart near;
   near.segment = candidates_.where[cluster.front()].segment;
   for (const int k : cluster) {
@@ -245,7 +373,7 @@ BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster) c
       near.nearest_gap = gap;
       near.segment = c.segment;
     }
-    if (gap <= context_.config.branches.fit_length_m) {
+    if (gap <= reach) {
       near.pts.push_back(candidates_.pts[k]);
       near.index.push_back(candidates_.index[k]);
     }
@@ -286,8 +414,8 @@ std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& n
 /// points spread over, shoots and spurs included (the checks and the extraction work with
 /// that); *wood_radius is the radius the branch reports.
 std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& seg,
-                                          const Direction& guess, std::vector<int>* inliers,
-                                          double* wood_radius) {
+                                          const Direction& guess, std::uint64_t seed,
+                                          std::vector<int>* inliers, double* wood_radius) {
   const ModelerConfig& config = context_.config;
   const BranchBands& bands = context_.bands;
   CylinderRansacConfig o;
@@ -296,9 +424,8 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.axis_candidates = AXIS_CANDIDATES;
   o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
   o.min_radius = MIN_BRANCH_RADIUS;
-  o.max_radius =
-      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
-  o.seed = config.seed * FIT_SEED_FACTOR + stream_++;
+  o.max_radius = config.fit.constrain ? maxBranchRadius(seg) : PAPER_MAX_BRANCH_RADIUS;
+  o.seed = seed;
   if (!config.fit.constrain) {
     auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);
     if (cyl)
@@ -469,9 +596,7 @@ bool BranchSearch::splitInHalves(const Candidate& candidate, const Points& clust
 /// Takes a found line's points (a branch, a wire) out of a cluster and looks again at what
 /// remains of it. Returns the points taken out.
 std::vector<int> BranchSearch::searchRest(const std::vector<int>& cluster, const Cylinder& found) {
-  const BranchBands& bands = context_.bands;
-  const double reach =
-      found.radius + noiseBand(std::max(bands.sigma, bands.scatter)) + EXTRACTION_MARGIN;
+  const double reach = extractionReach(found);
   std::vector<int> taken, rest;
   for (const int k : cluster)
     (axisDistance(found, candidates_.pts[k]) > reach ? rest : taken).push_back(k);

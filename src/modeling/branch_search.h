@@ -111,10 +111,18 @@ class BranchSearch {
   };
 
   void examine(const Candidate& candidate);
-  NearPart nearPart(const std::vector<int>& cluster) const;
+  NearPart nearPart(const std::vector<int>& cluster, double reach) const;
+  bool refitAtFork(const Candidate& candidate, const Cylinder& seg, const Direction& guess,
+                   NearPart* near, Cylinder* cyl, std::vector<int>* inliers, double* wood_radius);
+  std::optional<Cylinder> baseFit(const Candidate& candidate, const Cylinder& seg,
+                                  const Direction& guess);
+  NearPart alongLine(const NearPart& near, const Cylinder& line, const Cylinder& side_arm) const;
+  double extractionReach(const Cylinder& found) const;
   std::optional<Direction> direction(const NearPart& near, const Cylinder& seg) const;
   std::optional<Cylinder> fit(const NearPart& near, const Cylinder& seg, const Direction& guess,
-                              std::vector<int>* inliers, double* wood_radius);
+                              std::uint64_t seed, std::vector<int>* inliers, double* wood_radius);
+  std::uint64_t nextFitSeed();
+  std::uint64_t nextRefitSeed();
   std::optional<Verdict> checkDirection(const Candidate& candidate, const Cylinder& fit,
                                         const Cylinder& seg, const Direction& guess,
                                         double gap) const;
@@ -137,6 +145,8 @@ class BranchSearch {
   std::vector<Candidate> work_;
   int extractions_ = 0;
   std::uint64_t stream_ = 0;  // of random seeds, one per k-means split and per fit
+  // Of the refits at forks, apart: a refit leaves every other fit's seed as it was.
+  std::uint64_t refit_stream_ = 0;
   std::vector<BranchFit> branches_;
   std::vector<CutFit> cut_;
 };

@@ -1,0 +1,61 @@
+// A primary with a side arm (a secondary, a shoot at its tip) forking off it inside the fit
+// window: the branch is fitted along the primary, not along the arm, and the arm is no branch.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "built_scene.h"
+#include "dormant_tree_modeling/modeling/branch_model.h"
+#include "dormant_tree_modeling/modeling/point_index.h"
+
+namespace dormant_tree_modeling {
+namespace modeling {
+namespace {
+
+using test::addCylinder;
+using test::buildTrunk;
+
+constexpr double DEG = M_PI / 180.0;
+const Eigen::Vector3d SURFACE(0.03, 0, 0.9);  // where the primary leaves the 3 cm trunk
+const Eigen::Vector3d OUT = Eigen::Vector3d(1, 0, 0.1).normalized();
+constexpr double FORK_OFF = 0.10;  // m off the trunk surface, inside the fit window
+
+/// The direction `azimuth_deg` around the vertical from OUT, rising as OUT does.
+Eigen::Vector3d turned(double azimuth_deg) {
+  return Eigen::Vector3d(std::cos(azimuth_deg * DEG), std::sin(azimuth_deg * DEG), 0.1)
+      .normalized();
+}
+
+/// The trunk, a 20 cm primary and a 30 cm arm leaving it 10 cm out at `arm_azimuth_deg`: the
+/// arm is longer than what follows of the primary, so a line along it holds more returns.
+Points forkedScene(double arm_azimuth_deg, std::size_t* trunk_points) {
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
+  *trunk_points = pts.size();
+  addCylinder(pts, SURFACE, OUT, 0.006, 0.20);
+  addCylinder(pts, SURFACE + FORK_OFF * OUT, turned(arm_azimuth_deg), 0.005, 0.30);
+  return pts;
+}
+
+double lineAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) / DEG;
+}
+
+TEST(BranchFork, APrimaryIsFittedAlongItselfNotAlongItsSideArm) {
+  std::size_t trunk_points = 0;
+  const Points pts = forkedScene(30.0, &trunk_points);
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
+  const auto kept = modelBranches(pts, PointIndex(pts), trunk, region, config, nullptr);
+  // One branch: the arm's returns go with it (a secondary is no primary).
+  ASSERT_EQ(kept.size(), 1u);
+  // The arm's line misses the trunk axis by 6.5 cm; the primary's passes through it.
+  EXPECT_LT(lineAngleDeg(kept[0].cylinder.axis, OUT), 5.0);
+  EXPECT_NEAR(kept[0].attachment.z(), SURFACE.z(), 0.02);
+  EXPECT_TRUE(kept[0].reaches_surface);
+}
+
+}  // namespace
+}  // namespace modeling
+}  // namespace dormant_tree_modeling
