@@ -242,11 +242,9 @@ void BranchSearch::examine(const Candidate& candidate) {
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   std::vector<int> inliers;
   double wood_radius = 0.0;
-  auto cyl = fit(near, seg, *guess, nextFitSeed(), &inliers, &wood_radius);
-  if (!cyl || static_cast<int>(inliers.size()) < config.branches.min_points)
+  auto cyl = outwardFit(near, seg, *guess, nextFitSeed(), &inliers, &wood_radius);
+  if (!cyl)
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
-  if (cyl->axis.dot(guess->radial) < 0.0)
-    cyl->axis = -cyl->axis;
   if (config.fit.constrain && missesLikeASideArm(*cyl, seg))
     refitAtFork(candidate, seg, *guess, &near, &*cyl, &inliers, &wood_radius);
   Eigen::Vector3d attachment;
@@ -289,19 +287,15 @@ bool BranchSearch::refitAtFork(const Candidate& candidate, const Cylinder& seg,
   if (!base)
     return false;
   NearPart along = alongLine(*near, *base, *cyl);
-  const int min_points = context_.config.branches.min_points;
-  if (static_cast<int>(along.pts.size()) < min_points)
+  if (static_cast<int>(along.pts.size()) < context_.config.branches.min_points)
     return false;
   Direction from_base = guess;
   from_base.axis = base->axis;
   std::vector<int> in;
   double wood = 0.0;
-  auto refit = fit(along, seg, from_base, nextRefitSeed(), &in, &wood);
-  if (!refit || static_cast<int>(in.size()) < min_points)
-    return false;
-  if (refit->axis.dot(guess.radial) < 0.0)
-    refit->axis = -refit->axis;
-  if (!leadsIntoTheTrunk(*refit, seg) || lineAngle(refit->axis, cyl->axis) > FORK_MAX_TURN)
+  const auto refit = outwardFit(along, seg, from_base, nextRefitSeed(), &in, &wood);
+  if (!refit || !leadsIntoTheTrunk(*refit, seg) ||
+      lineAngle(refit->axis, cyl->axis) > FORK_MAX_TURN)
     return false;
   *near = std::move(along);
   *cyl = *refit;
@@ -320,12 +314,8 @@ std::optional<Cylinder> BranchSearch::baseFit(const Candidate& candidate, const 
     return std::nullopt;
   std::vector<int> in;
   double wood = 0.0;
-  auto b = fit(base, seg, guess, nextRefitSeed(), &in, &wood);
-  if (!b || static_cast<int>(in.size()) < config.branches.min_points)
-    return std::nullopt;
-  if (b->axis.dot(guess.radial) < 0.0)
-    b->axis = -b->axis;
-  if (!leadsIntoTheTrunk(*b, seg))
+  auto b = outwardFit(base, seg, guess, nextRefitSeed(), &in, &wood);
+  if (b && !leadsIntoTheTrunk(*b, seg))
     return std::nullopt;
   return b;
 }
@@ -447,6 +437,18 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
     spread = table.correct(spread, bands.table_sigma, MIN_BRANCH_RADIUS);
   }
   cyl->radius = spread;
+  return cyl;
+}
+
+/// A fit with at least branches.min_points inliers, its axis pointing away from the trunk.
+std::optional<Cylinder> BranchSearch::outwardFit(const NearPart& part, const Cylinder& seg,
+                                                 const Direction& guess, std::uint64_t seed,
+                                                 std::vector<int>* inliers, double* wood_radius) {
+  auto cyl = fit(part, seg, guess, seed, inliers, wood_radius);
+  if (!cyl || static_cast<int>(inliers->size()) < context_.config.branches.min_points)
+    return std::nullopt;
+  if (cyl->axis.dot(guess.radial) < 0.0)
+    cyl->axis = -cyl->axis;
   return cyl;
 }
 

@@ -121,6 +121,9 @@ class BranchSearch {
   std::optional<Direction> direction(const NearPart& near, const Cylinder& seg) const;
   std::optional<Cylinder> fit(const NearPart& near, const Cylinder& seg, const Direction& guess,
                               std::uint64_t seed, std::vector<int>* inliers, double* wood_radius);
+  std::optional<Cylinder> outwardFit(const NearPart& part, const Cylinder& seg,
+                                     const Direction& guess, std::uint64_t seed,
+                                     std::vector<int>* inliers, double* wood_radius);
   std::uint64_t nextFitSeed();
   std::uint64_t nextRefitSeed();
   std::optional<Verdict> checkDirection(const Candidate& candidate, const Cylinder& fit,
