@@ -106,11 +106,6 @@ double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::
   return (x - y).norm();
 }
 
-/// The widest radius ours allows a branch: its trunk segment's.
-double maxBranchRadius(const Cylinder& seg) {
-  return std::max(MIN_BRANCH_RADIUS * 2, seg.radius);
-}
-
 /// How far a fit's axis passes outside the trunk segment's surface (m; negative: through it).
 double axisGapOutside(const Cylinder& fit, const Cylinder& seg) {
   return lineGap(fit.center, fit.axis, seg.center, seg.axis, nullptr) - seg.radius;
@@ -414,7 +409,8 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.axis_candidates = AXIS_CANDIDATES;
   o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
   o.min_radius = MIN_BRANCH_RADIUS;
-  o.max_radius = config.fit.constrain ? maxBranchRadius(seg) : PAPER_MAX_BRANCH_RADIUS;
+  o.max_radius =
+      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
   o.seed = seed;
   if (!config.fit.constrain) {
     auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);
@@ -467,8 +463,7 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidat
   const bool sideways =
       across.norm() > MIN_ACROSS_SHARE &&
       angleBetween(across.normalized(), guess.radial) > config.branches.max_azimuth_deg * DEG;
-  const bool off_ray = candidate.ray && std::acos(std::clamp(std::abs(fit.axis.dot(*candidate.ray)),
-                                                             -1.0, 1.0)) > RAY_AGREEMENT;
+  const bool off_ray = candidate.ray && lineAngle(fit.axis, *candidate.ray) > RAY_AGREEMENT;
   if (off_ray)
     return Verdict{BranchRejection::OFF_ITS_RAY, true};
   if (angleBetween(fit.axis, guess.radial) > guess.max_angle || sideways)

@@ -48,7 +48,7 @@ TEST(BranchFork, APrimaryIsFittedAlongItselfNotAlongItsSideArm) {
   const Points pts = forkedScene(30.0, &trunk_points);
   auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   const auto kept = modelBranches(pts, PointIndex(pts), trunk, region, config, nullptr);
-  // One branch: the arm's returns go with it (a secondary is no primary).
+  // One branch: the arm, searched again once the primary is taken out, is no primary.
   ASSERT_EQ(kept.size(), 1u);
   // The arm's line misses the trunk axis by 6.5 cm; the primary's passes through it.
   EXPECT_LT(lineAngleDeg(kept[0].cylinder.axis, OUT), 5.0);
