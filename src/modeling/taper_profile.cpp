@@ -12,11 +12,56 @@ namespace modeling {
 namespace {
 constexpr int ROUNDS = 4;
 constexpr double MIN_SPREAD = 1e-4;  // m: a floor on the robust sigma of exact fixtures
+// Slices within this height of the lowest may be cut by the ground's mixed pixels: where the
+// ground behind a trunk lies within the scanner's echo merging distance along the beam (0.45 m
+// for the LMS111 model, at the 30-40 degree depression of the trunk's base seen from the
+// platform), edge returns land between trunk and ground, inside the circle.
+constexpr double GROUND_MIXING_HEIGHT = 0.3;  // m
+// The slices above a base run that say what it should read (median), and by how many robust
+// sigmas of the slice-to-slice scatter all of the run must read under them.
+constexpr double BASE_REFERENCE_HEIGHT = 0.25;  // m
+constexpr std::size_t MIN_REFERENCE_SLICES = 3;
+constexpr double BASE_STEP_SIGMAS = 1.0;
+
+using Samples = std::vector<std::pair<double, double>>;  // (arc length of the middle, radius)
+
+/// Robust sigma of one slice's radius from the steps between neighbours: taper and branch
+/// bases move few of them.
+double stepSpread(const Samples& pts) {
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < pts.size(); ++k)
+    steps.push_back(std::abs(pts[k].second - pts[k - 1].second));
+  return std::max(1.4826 * median(std::move(steps)) / std::sqrt(2.0), MIN_SPREAD);
+}
+
+/// The number of lowest slices the ground's mixed pixels cut: the longest run within
+/// GROUND_MIXING_HEIGHT of the lowest slice whose every slice reads under the median of the
+/// slices just above the run. A trunk thins upwards, so no honest base slice does.
+std::size_t groundMixedBase(const Samples& pts) {
+  const double spread = stepSpread(pts);
+  std::size_t base = 0;
+  double run_max = 0.0;
+  for (std::size_t m = 1; m < pts.size(); ++m) {
+    if (pts[m - 1].first - pts.front().first >= GROUND_MIXING_HEIGHT)
+      break;
+    run_max = std::max(run_max, pts[m - 1].second);
+    std::vector<double> reference;
+    for (std::size_t j = m; j < pts.size() && pts[j].first < pts[m].first + BASE_REFERENCE_HEIGHT;
+         ++j) {
+      reference.push_back(pts[j].second);
+    }
+    if (reference.size() >= MIN_REFERENCE_SLICES &&
+        run_max < median(std::move(reference)) - BASE_STEP_SIGMAS * spread) {
+      base = m;
+    }
+  }
+  return base;
+}
 }  // namespace
 
 std::optional<TaperProfile> TaperProfile::fit(const std::vector<Slice>& slices, double slice_height,
                                               double below, double above) {
-  std::vector<std::pair<double, double>> pts;  // (arc length of the middle, corrected radius)
+  Samples pts;  // corrected radii
   for (const auto& sl : slices) {
     if (sl.has_circle)
       pts.emplace_back(sl.s0 + 0.5 * slice_height, sl.corrected_radius);
@@ -28,7 +73,12 @@ std::optional<TaperProfile> TaperProfile::fit(const std::vector<Slice>& slices, 
   p.s1_ = pts.back().first;
   if (!(p.s1_ - p.s0_ > 1e-6))
     return std::nullopt;
-  std::vector<char> used(pts.size(), 1);
+  const std::size_t base = groundMixedBase(pts);
+  if (pts.size() - base < MIN_SLICES)
+    return std::nullopt;
+  p.hold_ = pts[base].first;
+  std::vector<char> used(pts.size(), 0);
+  std::fill(used.begin() + base, used.end(), 1);
   for (int round = 0; round < ROUNDS; ++round) {
     Eigen::Matrix4d AtA = Eigen::Matrix4d::Zero();
     Eigen::Vector4d Atb = Eigen::Vector4d::Zero();
@@ -54,13 +104,13 @@ std::optional<TaperProfile> TaperProfile::fit(const std::vector<Slice>& slices, 
     }
     const double spread = std::max(1.4826 * median(std::move(magnitude)), MIN_SPREAD);
     for (std::size_t k = 0; k < pts.size(); ++k)
-      used[k] = residuals[k] > -below * spread && residuals[k] < above * spread;
+      used[k] = k >= base && residuals[k] > -below * spread && residuals[k] < above * spread;
   }
   return p;
 }
 
 double TaperProfile::at(double s) const {
-  return c_.dot(basis(s));
+  return c_.dot(basis(std::max(s, hold_)));
 }
 
 double TaperProfile::mean(double a, double b) const {

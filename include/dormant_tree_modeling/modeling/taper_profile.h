@@ -18,6 +18,10 @@ namespace modeling {
 /// fitted to all slices at once, in rounds that leave out slices more than `below` robust
 /// standard deviations (1.4826 x median absolute residual) under it or `above` over it (a
 /// branch base only widens a slice: the upper bound may be the tighter one).
+///
+/// The lowest slices are left out where they all read under the slices just above them: the
+/// ground's mixed pixels pull a trunk base's circles in (a trunk thins upwards, so no honest
+/// base slice reads thin). Below the lowest slice kept the profile holds its value there.
 class TaperProfile {
  public:
   /// @brief The profile of the slices with a circle, or nothing when fewer than MIN_SLICES
@@ -29,7 +33,7 @@ class TaperProfile {
   static std::optional<TaperProfile> fit(const std::vector<Slice>& slices, double slice_height,
                                          double below, double above);
 
-  /// @brief Radius (m) at arc length s (held at the end values beyond the slices).
+  /// @brief Radius (m) at arc length s (held at the end values beyond the slices kept).
   double at(double s) const;
 
   /// @brief Mean radius (m) over arc lengths [a, b].
@@ -41,6 +45,7 @@ class TaperProfile {
   Eigen::Vector4d basis(double s) const;
 
   double s0_ = 0.0, s1_ = 1.0;
+  double hold_ = 0.0;  ///< arc length of the lowest slice kept
   Eigen::Vector4d c_ = Eigen::Vector4d::Zero();
 };
 
