@@ -490,7 +490,7 @@ modeling::SensorCalibration::Silhouette fitGrowth(const std::vector<SilhouetteSa
     std::vector<double> residuals;
     for (const auto& g : samples)
       residuals.push_back(std::abs(model.target(g) - model.terms(g).dot(p)));
-    const double sigma = 1.4826 * median(residuals);
+    const double sigma = sigmaFromAbsoluteDeviations(residuals);
     for (std::size_t i = 0; i < samples.size(); ++i)
       keep[i] = residuals[i] <= SILHOUETTE_OUTLIER_SIGMAS * sigma;
   }

@@ -20,6 +20,11 @@ double quantileInPlace(std::vector<double>& values, double q) {
   return values[k];
 }
 
+double sigmaFromAbsoluteDeviations(std::vector<double> abs_deviations) {
+  constexpr double NORMAL_MAD_TO_SIGMA = 1.4826;
+  return NORMAL_MAD_TO_SIGMA * median(std::move(abs_deviations));
+}
+
 std::vector<double> axisSample(const std::vector<Eigen::Vector3d>& points, int axis,
                                std::size_t max_samples) {
   const std::size_t stride = std::max<std::size_t>(1, points.size() / max_samples);

@@ -225,7 +225,7 @@ double noiseFromRadialResiduals(std::vector<double> residuals) {
   const double centre = median(residuals);
   for (double& r : residuals)
     r = std::abs(r - centre);
-  return 1.4826 * median(std::move(residuals)) * std::sqrt(1.5);
+  return sigmaFromAbsoluteDeviations(std::move(residuals)) * std::sqrt(1.5);
 }
 
 double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, double band,

@@ -31,7 +31,7 @@ double stepSpread(const Samples& pts) {
   std::vector<double> steps;
   for (std::size_t k = 1; k < pts.size(); ++k)
     steps.push_back(std::abs(pts[k].second - pts[k - 1].second));
-  return std::max(1.4826 * median(std::move(steps)) / std::sqrt(2.0), MIN_SPREAD);
+  return std::max(sigmaFromAbsoluteDeviations(std::move(steps)) / std::sqrt(2.0), MIN_SPREAD);
 }
 
 /// The number of lowest slices the ground's mixed pixels cut: the longest run within
@@ -102,7 +102,7 @@ std::optional<TaperProfile> TaperProfile::fit(const std::vector<Slice>& slices, 
       residuals[k] = pts[k].second - p.at(pts[k].first);
       magnitude[k] = std::abs(residuals[k]);
     }
-    const double spread = std::max(1.4826 * median(std::move(magnitude)), MIN_SPREAD);
+    const double spread = std::max(sigmaFromAbsoluteDeviations(std::move(magnitude)), MIN_SPREAD);
     for (std::size_t k = 0; k < pts.size(); ++k)
       used[k] = k >= base && residuals[k] > -below * spread && residuals[k] < above * spread;
   }

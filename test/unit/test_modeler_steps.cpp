@@ -25,16 +25,16 @@ namespace {
 using test::addCylinder;
 using test::buildTrunk;
 
-/// 30 slices 5 cm high, each slice's corrected radius the taper at its middle, off by
+/// 30 slices `h` m high, each slice's corrected radius the taper at its middle, off by
 /// +-`wobble` m alternately.
-std::vector<Slice> taperedSlices(const std::function<double(double)>& taper, double wobble) {
-  constexpr double H = 0.05;
+std::vector<Slice> taperedSlices(const std::function<double(double)>& taper, double h,
+                                 double wobble) {
   std::vector<Slice> slices(30);
   for (std::size_t k = 0; k < slices.size(); ++k) {
     Slice& sl = slices[k];
-    sl.s0 = k * H;
+    sl.s0 = k * h;
     sl.has_circle = true;
-    sl.corrected_radius = taper(sl.s0 + 0.5 * H) + (k % 2 ? wobble : -wobble);
+    sl.corrected_radius = taper(sl.s0 + 0.5 * h) + (k % 2 ? wobble : -wobble);
   }
   return slices;
 }
@@ -199,7 +199,7 @@ TEST(TaperProfile, FollowsTheTaperPastWideSlices) {
   // profile are within 0.6 mm of the truth; their median slices are not.
   const double h = 0.05;
   const auto truth = [](double s) { return 0.05 - 0.02 * s; };
-  std::vector<Slice> slices = taperedSlices(truth, 0.0015);
+  std::vector<Slice> slices = taperedSlices(truth, h, 0.0015);
   for (std::size_t k = 2; k < slices.size(); k += 5)
     slices[k].corrected_radius += 0.012;
   const auto profile = TaperProfile::fit(slices, h, 2.5, 2.0);
@@ -231,7 +231,7 @@ TEST(TaperProfile, LeavesOutABaseTheGroundsMixedPixelsCut) {
   // lowest slice kept); with those slices in the fit it read 4.1 mm thin.
   const double h = 0.05;
   const auto truth = [](double s) { return 0.05 - 0.01 * s; };
-  const std::vector<Slice> slices = taperedSlices(truth, 0.0005);
+  const std::vector<Slice> slices = taperedSlices(truth, h, 0.0005);
   std::vector<Slice> cut = slices;
   for (std::size_t k = 0; k < 5; ++k)
     cut[k].corrected_radius -= 0.008;
