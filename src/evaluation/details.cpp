@@ -3,6 +3,7 @@
 #include <string>
 
 #include "dormant_tree_modeling/evaluation/matching.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 namespace dormant_tree_modeling {
 namespace evaluation {
@@ -17,7 +18,7 @@ double polylineLength(const Polyline& line) {
 }
 
 double axisAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+  return modeling::lineAngle(a.normalized(), b.normalized()) * 180.0 / M_PI;
 }
 
 /// The polyline (of a list) nearest to a point, its index and where on it.

@@ -1,6 +1,7 @@
 #include "dormant_tree_modeling/evaluation/matching.h"
 
 #include "dormant_tree_modeling/common/error.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -40,8 +41,7 @@ bool canMatch(const modeling::CylinderModel& detection, const Polyline& line,
     *e = q.distance;
   if (at)
     *at = q;
-  const double angle =
-      std::acos(std::min(1.0, std::abs(detection.axis.normalized().dot(q.direction))));
+  const double angle = modeling::lineAngle(detection.axis.normalized(), q.direction);
   return q.distance <= std::max(bounds.min_distance, q.diameter) &&
          q.arc_length <= bounds.max_arc_length && angle <= bounds.max_angle_deg * M_PI / 180.0;
 }

@@ -81,11 +81,6 @@ double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
 }
 
-/// The angle between two lines (the directions' signs ignored).
-double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(std::abs(a.dot(b)), 0.0, 1.0));
-}
-
 /// Closest points between two lines p + t u and q + s v: returns the distance between the
 /// lines and, in on_second, the point on the second.
 double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& q,

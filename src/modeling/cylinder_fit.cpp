@@ -43,6 +43,10 @@ void finish(Cylinder& c, const Points& pts) {
 
 }  // namespace
 
+double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.dot(b))));
+}
+
 double axisDistance(const Cylinder& c, const Eigen::Vector3d& p) {
   const Eigen::Vector3d w = p - c.center;
   return (w - w.dot(c.axis) * c.axis).norm();
@@ -204,7 +208,7 @@ std::optional<Cylinder> ransacCylinder(const Points& pts, const Eigen::Vector3d&
   auto cyl = fitCylinder(sub, best_axis);
   // The refinement may leave the radius bounds or the axis cone: fall back to a fixed axis.
   if (!cyl || cyl->radius < o.min_radius || cyl->radius > o.max_radius ||
-      std::acos(std::min(1.0, std::abs(cyl->axis.dot(guess)))) > o.max_axis_deviation) {
+      lineAngle(cyl->axis, guess) > o.max_axis_deviation) {
     cyl = fitCylinder(sub, best_axis, true);
   }
   if (!cyl || cyl->radius < o.min_radius || cyl->radius > o.max_radius)

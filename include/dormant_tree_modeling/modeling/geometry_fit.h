@@ -32,6 +32,10 @@ struct Cylinder {
 /// @brief Distance of p to the infinite axis of c.
 double axisDistance(const Cylinder& c, const Eigen::Vector3d& p);
 
+/// @brief The angle (rad) between two lines along unit directions a and b, their signs
+/// ignored: in [0, pi/2].
+double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
 /// @brief Circle through three points; nothing when they are (nearly) collinear.
 std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                                     const Eigen::Vector2d& c);
