@@ -1,6 +1,7 @@
 #include "dormant_tree_modeling/modeling/trunk_search.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -42,6 +43,10 @@ constexpr int COLUMN_HALF_CELLS = 2;
 constexpr int COLUMN_STARTS = 3;
 // A start whose track climbs this share of the clusters' height above it stands on a trunk.
 constexpr double STANDING_CLIMB = 0.5;
+constexpr int RETRY_MISSES = 4;  // a retry's run of missed slices that ends it
+// A column's retries trust each of these radii (m): with the trusted first circle's 0.6x..1.6x
+// they cover 12..128 mm, young to mature apple trunks.
+constexpr std::array<double, 3> COLUMN_RETRY_RADII_M = {0.02, 0.04, 0.08};
 
 /// Range-noise guess from a cluster's cylinder-fit residuals; the slices refine it later.
 double noiseGuess(const Points& pts, const Cluster& cluster) {
@@ -108,28 +113,36 @@ double trackingThreshold(const Points& pts, const std::vector<Cluster>& clusters
   return std::max(0.5 * config.fit.circle_threshold_m, noiseBand(median(guesses)));
 }
 
-/// Up from the start, retried from the start's own radius when a wide first circle stopped it
-/// low, then down to the ground.
+/// Up from the start, retried from a trusted radius when the free first circle stopped it low,
+/// then down to the ground.
 TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkStart& start,
                        double threshold, double zmax, const ModelerConfig& config) {
   // Tracking starts upright: a fragment's fitted axis can lean by tens of degrees, and an
   // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   TrackedTrunk tracked = trackTrunk(pts, index, start.base, up, start.radius, threshold, config);
-  // The free first circle can take in what stands around the base (suckers, weeds, soil
-  // pixels) and set a radius the trunk above never matches: a track that stops low after a
-  // first circle much wider than its start is tried again from the start's own radius, and
-  // the one that climbs higher is kept.
   const auto climb = [&](const TrackedTrunk& t) {
     return t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
   };
-  const bool wide_first =
-      tracked.radii.empty() || tracked.radii.front() > RETRY_WIDTH * start.radius;
-  if (wide_first && climb(tracked) < 0.5 * (zmax - start.base.z())) {
-    TrackedTrunk retry =
-        trackTrunk(pts, index, start.base, up, start.radius, threshold, config, 4, true);
-    if (climb(retry) > climb(tracked))
-      tracked = std::move(retry);
+  const auto retry = [&](double radius) {
+    if (climb(tracked) >= STANDING_CLIMB * (zmax - start.base.z()))
+      return;
+    TrackedTrunk again =
+        trackTrunk(pts, index, start.base, up, radius, threshold, config, RETRY_MISSES, true);
+    if (climb(again) > climb(tracked))
+      tracked = std::move(again);
+  };
+  // The free first circle can take in what stands around the base (suckers, weeds, soil
+  // pixels) and set a radius the trunk above never matches: a track that stops low after a
+  // first circle much wider than its start is tried again from the start's own radius.
+  if (tracked.radii.empty() || tracked.radii.front() > RETRY_WIDTH * start.radius)
+    retry(start.radius);
+  // A density column has no radius of its own (its guess is the cluster starts', a post's
+  // among them), and mixed pixels smear a wide disc around its foot that the free circle takes:
+  // a column's track that stops low is tried from each trunk size.
+  if (start.from_column) {
+    for (const double radius : COLUMN_RETRY_RADII_M)
+      retry(radius);
   }
   if (tracked.centers.size() < 3)
     return tracked;
