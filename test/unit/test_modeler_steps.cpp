@@ -332,6 +332,25 @@ TEST(TrunkTracking, AtANoisyWhorlTheTrackStaysOnTheLeader) {
   EXPECT_LT(worst, 0.03);
 }
 
+/// A trunk's foot cluster whose cylinder fit lies on its side, as mixed pixels behind the
+/// trunk make it.
+Cluster flatFootCluster() {
+  Cluster c;
+  c.centroid = {0, 0, 0.1};
+  c.fit = Cylinder{{0, 0, 0.1}, {1, 0, 0}, 0.03, 0.3};
+  c.members.resize(200);
+  return c;
+}
+
+/// trackBestTrunk with the default config, Algorithm 2's path starting at cluster 1 (a post).
+std::optional<TrackedTrunk> trackFromPost(const Points& pts, const std::vector<Cluster>& clusters,
+                                          std::vector<TrunkCandidate>* report) {
+  TrunkPath path;
+  path.trunk = {1};
+  const PointIndex index(pts);
+  return trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, report);
+}
+
 TEST(TrunkSearch, ADenseColumnAwayFromTheStartsIsAStart) {
   // Two trunks (r 4 cm, 0.5 m tall) and a thin sheet of smeared returns: the one at (1, 0)
   // already has a start, the one at (0, 0) gets a column start at its foot; the sheet, spread
@@ -368,17 +387,11 @@ TEST(TrunkSearch, ATrunkWhoseFootClustersLieFlatIsFoundFromItsColumn) {
   const int tree_points = static_cast<int>(pts.size());
   addCylinder(pts, {0.5, 0.3, 0}, {0, 0, 1}, 0.04, 1.5);
   std::vector<Cluster> clusters(2);
-  clusters[0].centroid = {0, 0, 0.1};
-  clusters[0].fit = Cylinder{{0, 0, 0.1}, {1, 0, 0}, 0.03, 0.3};
-  clusters[0].members.resize(200);
+  clusters[0] = flatFootCluster();
   clusters[1] = clusterOf(pts, tree_points, static_cast<int>(pts.size()));
   clusters[1].centroid.z() = 0.1;
-  TrunkPath path;
-  path.trunk = {1};
-  const PointIndex index(pts);
-  ModelerConfig config;
   std::vector<TrunkCandidate> report;
-  const auto best = trackBestTrunk(pts, index, clusters, path, config, &report);
+  const auto best = trackFromPost(pts, clusters, &report);
   ASSERT_TRUE(best);
   EXPECT_LT(best->centers.front().head<2>().norm(), 0.02);
   EXPECT_GT(best->centers.back().z(), 1.2);
@@ -410,9 +423,7 @@ TEST(TrunkSearch, AColumnInASmearedFootIsTrackedAtItsOwnSize) {
     pts.emplace_back(rho * std::cos(phi), rho * std::sin(phi), rng.uniform(0.0, 0.6));
   }
   std::vector<Cluster> clusters(4);
-  clusters[0].centroid = {0, 0, 0.1};
-  clusters[0].fit = Cylinder{{0, 0, 0.1}, {1, 0, 0}, 0.03, 0.3};
-  clusters[0].members.resize(200);
+  clusters[0] = flatFootCluster();
   for (int k = 1; k <= 2; ++k) {
     const int begin = static_cast<int>(pts.size());
     addCylinder(pts, {0.5, k == 1 ? 0.3 : -0.3, 0}, {0, 0, 1}, 0.06, 2.5);
@@ -421,12 +432,8 @@ TEST(TrunkSearch, AColumnInASmearedFootIsTrackedAtItsOwnSize) {
     clusters[k].centroid.z() = 0.1;
   }
   clusters[3].centroid = {0, 0, 2.4};  // the crown: the clusters' height
-  TrunkPath path;
-  path.trunk = {1};
-  const PointIndex index(pts);
-  ModelerConfig config;
   std::vector<TrunkCandidate> report;
-  const auto best = trackBestTrunk(pts, index, clusters, path, config, &report);
+  const auto best = trackFromPost(pts, clusters, &report);
   ASSERT_TRUE(best);
   const auto column = std::find_if(report.begin(), report.end(),
                                    [](const TrunkCandidate& c) { return c.from_column; });
