@@ -229,6 +229,13 @@ Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationRes
   return merged;
 }
 
+Cloud registeredFolderCloud(const std::string& dir, const ViewFolderConfig& options,
+                            const RegistrationResult& result) {
+  ViewFolderConfig with_ground = options;
+  with_ground.ground_margin = -1;
+  return registeredCloud(readViewFolder(dir, with_ground).views, result);
+}
+
 void writeRegistration(const std::string& dir, const Cloud& registered,
                        const RegistrationResult& result, const std::optional<PoseErrors>& errors,
                        const std::optional<RegistrationInput>& input) {

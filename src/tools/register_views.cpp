@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
       "ignore the guessed platform poses: a global search from scratch (slide moves are kept)")(
       "no-crop",
       "register the whole views with the ground (default: 1.2 m around where the guess "
-      "expects the tree, ground removed)");
+      "expects the tree, ground removed for the registration, kept in registered.pcd)");
   po::positional_options_description pos;
   pos.add("dir", 1);
   try {
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     const auto e = registration::poseErrors(result, folder.true_poses);
     if (e.views > 0)
       errors = e;
-    const Cloud registered = registration::registeredCloud(folder.views, result);
+    const Cloud registered = registration::registeredFolderCloud(dir, fo, result);
     registration::writeRegistration(out, registered, result, errors);
     const std::size_t points = registered.size();
     int left_out = 0;

@@ -314,6 +314,32 @@ TEST(ViewFolder, WarnsOfANearlyEmptyViewAndRefusesMistypedKeys) {
   }
 }
 
+TEST(ViewFolder, TheRegisteredCloudKeepsTheGroundTheRegistrationLeftOut) {
+  // One view 1 m above the ground (its guess says so), a trunk standing on it: the reading for
+  // the registration drops the lowest 10 cm, the registered cloud keeps the trunk's foot.
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("views"));
+  Cloud view;
+  for (int i = 0; i <= 100; ++i)
+    view.push_back(pcl::PointXYZ(1.0f, 0.0f, -1.0f + 0.01f * i));
+  io::writeCloud(dir.file("views/a.pcd"), view);
+  std::ofstream(dir.file("views.json"))
+      << R"({"views": [{"name": "a", "platform_index": 0, "guess_pose": )"
+      << R"({"translation": [0, 0, 1], "rotation_xyzw": [0, 0, 0, 1]}}]})";
+  const ViewFolderConfig options;
+  const ViewFolder f = readViewFolder(dir.file(""), options);
+  ASSERT_EQ(f.views.size(), 1u);
+  RegistrationResult result;
+  result.views.resize(1);
+  result.views[0].registered = true;
+  const Cloud cloud = registeredFolderCloud(dir.file(""), options, result);
+  EXPECT_EQ(f.views[0].points.size(), 91u);  // above the ground + 10 cm
+  ASSERT_EQ(cloud.size(), view.size());
+  EXPECT_FLOAT_EQ(cloud.front().z, -1.0f);
+  result.views.clear();
+  EXPECT_THROW(registeredFolderCloud(dir.file(""), options, result), Error);
+}
+
 }  // namespace
 }  // namespace registration
 }  // namespace dormant_tree_modeling
