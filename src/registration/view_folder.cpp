@@ -230,7 +230,9 @@ Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationRes
 }
 
 Cloud registeredFolderCloud(const std::string& dir, const ViewFolderConfig& options,
-                            const RegistrationResult& result) {
+                            const ViewFolder& read, const RegistrationResult& result) {
+  if (options.ground_margin < 0)
+    return registeredCloud(read.views, result);
   ViewFolderConfig with_ground = options;
   with_ground.ground_margin = -1;
   return registeredCloud(readViewFolder(dir, with_ground).views, result);

@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     const auto e = registration::poseErrors(result, folder.true_poses);
     if (e.views > 0)
       errors = e;
-    const Cloud registered = registration::registeredFolderCloud(dir, fo, result);
+    const Cloud registered = registration::registeredFolderCloud(dir, fo, folder, result);
     registration::writeRegistration(out, registered, result, errors);
     const std::size_t points = registered.size();
     int left_out = 0;

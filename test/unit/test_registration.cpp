@@ -332,12 +332,16 @@ TEST(ViewFolder, TheRegisteredCloudKeepsTheGroundTheRegistrationLeftOut) {
   RegistrationResult result;
   result.views.resize(1);
   result.views[0].registered = true;
-  const Cloud cloud = registeredFolderCloud(dir.file(""), options, result);
+  const Cloud cloud = registeredFolderCloud(dir.file(""), options, f, result);
   EXPECT_EQ(f.views[0].points.size(), 91u);  // above the ground + 10 cm
   ASSERT_EQ(cloud.size(), view.size());
   EXPECT_FLOAT_EQ(cloud.front().z, -1.0f);
+  ViewFolderConfig with_ground;
+  with_ground.ground_margin = -1;
+  const ViewFolder whole = readViewFolder(dir.file(""), with_ground);
+  EXPECT_EQ(registeredFolderCloud(dir.file(""), with_ground, whole, result).size(), view.size());
   result.views.clear();
-  EXPECT_THROW(registeredFolderCloud(dir.file(""), options, result), Error);
+  EXPECT_THROW(registeredFolderCloud(dir.file(""), options, f, result), Error);
 }
 
 }  // namespace

@@ -98,12 +98,13 @@ std::string registrationReport(const RegistrationResult& result,
 /// @brief The registered views merged into one cloud (mergeRegistered as a PCL cloud).
 Cloud registeredCloud(const std::vector<ViewInput>& views, const RegistrationResult& result);
 
-/// @brief The registered cloud of the folder `dir`, registered as read with `options`: the same
-/// views and crop at their registered poses, with the ground kept. The registration leaves the
-/// ground out; a model needs the trunk's foot and the ground it stands on.
+/// @brief The registered cloud of the folder `dir`, registered as `read` with `options`: the
+/// same views and crop at their registered poses, with the ground kept. The registration leaves
+/// the ground out; a model needs the trunk's foot and the ground it stands on. The folder is
+/// read again only when `options` left the ground out.
 /// @throws Error as readViewFolder, INVALID_ARGUMENT when `result` is not of this folder
 Cloud registeredFolderCloud(const std::string& dir, const ViewFolderConfig& options,
-                            const RegistrationResult& result);
+                            const ViewFolder& read, const RegistrationResult& result);
 
 /// @brief Write a registration to a folder: registered.pcd and registered.ply (the merged
 /// registered views, from registeredCloud), registration.json and registration.md. Creates
