@@ -197,6 +197,7 @@ void scoreDetections(const modeling::TreeModel& model, const GroundTruth& truth,
       s.branch_mae += std::abs(err);
       s.branch_bias += err;
       sq += err * err;
+      s.unresolved += !model.primary_branches[d].measurement.diameter_resolved;
       s.matches.push_back(m);
       continue;
     }
@@ -313,6 +314,7 @@ TreeScore meanScore(const std::vector<TreeScore>& scores) {
     m.tp += s.tp;
     m.fp += s.fp;
     m.fn += s.fn;
+    m.unresolved += s.unresolved;
     m.fp_rate += s.fp_rate / n;
     m.fn_rate += s.fn_rate / n;
     m.f1 += s.f1 / n;

@@ -24,6 +24,7 @@ nlohmann::json toJson(const TreeScore& s) {
           {"fp", s.fp},
           {"fn", s.fn},
           {"ignored", s.ignored},
+          {"unresolved_diameters", s.unresolved},
           {"fp_rate", s.fp_rate},
           {"fn_rate", s.fn_rate},
           {"f1", s.f1},

@@ -229,6 +229,7 @@ std::string modelToJson(const modeling::TreeModel& model, const Eigen::Vector3d&
     j["trunk_diameter"] = b.measurement.trunk_diameter;
     j["diameter_ratio"] = b.measurement.diameter_ratio;
     j["prune"] = b.measurement.prune;
+    j["diameter_resolved"] = b.measurement.diameter_resolved;
     branches.push_back(j);
   }
   json doc{{"format", MODEL_FORMAT},
@@ -297,6 +298,8 @@ modeling::TreeModel modelFromDocument(const std::string& text) {
     }
     if (j.contains("prune") && j["prune"].is_boolean())
       b.measurement.prune = j["prune"].get<bool>();
+    if (j.contains("diameter_resolved") && j["diameter_resolved"].is_boolean())
+      b.measurement.diameter_resolved = j["diameter_resolved"].get<bool>();
     model.primary_branches.push_back(b);
   }
   model.correction = correctionFromJson(doc);

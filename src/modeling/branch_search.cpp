@@ -7,6 +7,7 @@
 
 #include "dormant_tree_modeling/modeling/branch_rays.h"
 #include "dormant_tree_modeling/modeling/noise_band.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 namespace dormant_tree_modeling {
@@ -16,7 +17,6 @@ namespace detail {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-constexpr double MIN_BRANCH_RADIUS = 0.002;  // m
 constexpr double SURFACE_CONTACT = 0.05;     // m beyond inner_gap that still touches the trunk
 // The paper's search: the RANSAC axis strays up to this far from the guess, and a branch may be
 // as wide as this.
@@ -403,9 +403,9 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.circle_iterations = config.fit.ransac_iterations / 2;
   o.axis_candidates = AXIS_CANDIDATES;
   o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
-  o.min_radius = MIN_BRANCH_RADIUS;
+  o.min_radius = MIN_BRANCH_RADIUS_M;
   o.max_radius =
-      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
+      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS_M * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
   o.seed = seed;
   if (!config.fit.constrain) {
     auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);
@@ -424,8 +424,8 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   *wood_radius = cyl->radius;
   if (calibrated && !config.branches.raw_radius) {
     const auto& table = config.branch_calibration;
-    *wood_radius = table.correct(*wood_radius, bands.table_sigma, MIN_BRANCH_RADIUS);
-    spread = table.correct(spread, bands.table_sigma, MIN_BRANCH_RADIUS);
+    *wood_radius = table.correct(*wood_radius, bands.table_sigma, MIN_BRANCH_RADIUS_M);
+    spread = table.correct(spread, bands.table_sigma, MIN_BRANCH_RADIUS_M);
   }
   cyl->radius = spread;
   return cyl;
@@ -508,7 +508,7 @@ void BranchSearch::accept(const Candidate& candidate, const NearPart& near, cons
   branch.cylinder.radius = wood_radius;
   if (config.noise.correct_bias && !config.fit.constrain) {
     branch.cylinder.radius =
-        noiseCorrectedRadius(fit, in, bands.sigma, bands.threshold, MIN_BRANCH_RADIUS);
+        noiseCorrectedRadius(fit, in, bands.sigma, bands.threshold, MIN_BRANCH_RADIUS_M);
   }
   branch.candidates = near.pts.size();
   branch.trunk_segment = near.segment;

@@ -84,6 +84,9 @@ std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t
   return out;
 }
 
+/// A branch radius within this share above MIN_BRANCH_RADIUS_M is the floor, not a measurement.
+constexpr double FLOOR_TOLERANCE = 1.0 + 1e-6;
+
 /// How far outside a calibration's covered radii and noise a tree may go before the model says
 /// the tables were held constant there: a rod's or a section's neighbourhood.
 constexpr double COVERAGE_RADIUS_SLACK = 0.15;
@@ -107,8 +110,8 @@ std::string outsideRange(const char* what, const std::vector<double>& radii, dou
 
 /// Which calibration the diameters went through, and where the tree needed it beyond its rig;
 /// sigma is the noise as the tables read it (TrunkModel::table_sigma).
-DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
-                                      double estimated_sigma, double sigma) {
+DiameterCorrection describeCalibration(const ModelerConfig& config, const TreeModel& model,
+                                       double estimated_sigma, double sigma) {
   DiameterCorrection d;
   d.noise_sigma = estimated_sigma;
   d.table_noise_sigma = sigma;
@@ -147,6 +150,33 @@ DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeMod
   return d;
 }
 
+/// The branches whose diameter is the floor, not a measurement (empty when none).
+std::string floorWarning(const TreeModel& model, double estimated_sigma) {
+  std::size_t at_floor = 0;
+  for (const auto& b : model.primary_branches)
+    at_floor += !b.measurement.diameter_resolved;
+  if (at_floor == 0)
+    return {};
+  char text[256];
+  std::snprintf(text, sizeof(text),
+                "%zu of %zu branch diameters were not measured: at %.1f mm of estimated range "
+                "noise their radius corrected to the %.0f mm floor (diameter_resolved false)",
+                at_floor, model.primary_branches.size(), 1000 * estimated_sigma,
+                2000 * MIN_BRANCH_RADIUS_M);
+  return text;
+}
+
+/// Which calibration the diameters went through, where the tree needed it beyond its rig, and
+/// which branches it took to the floor; sigma is the noise as the tables read it
+/// (TrunkModel::table_sigma).
+DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
+                                      double estimated_sigma, double sigma) {
+  DiameterCorrection d = describeCalibration(config, model, estimated_sigma, sigma);
+  const std::string floor = floorWarning(model, estimated_sigma);
+  if (!floor.empty())
+    d.warnings.push_back(floor);
+  return d;
+}
 /// Drops non-finite points (a copy only when there are some: a whole scan is hundreds of MB)
 /// and preprocesses the rest into result->points, ->preprocess and ->notices.
 /// @throws Error EMPTY_INPUT with fewer than MIN_POINTS before or after
@@ -316,6 +346,7 @@ PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
   pb.measurement.trunk_diameter = trunk.diameterAt(s);
   pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
   pb.measurement.prune = pb.measurement.diameter_ratio > config.prune_ratio;
+  pb.measurement.diameter_resolved = f.cylinder.radius > MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE;
   return pb;
 }
 

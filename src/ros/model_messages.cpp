@@ -98,6 +98,7 @@ dormant_tree_modeling::TreeModel toMsg(const modeling::TreeModel& model,
     m.trunk_diameter = b.measurement.trunk_diameter;
     m.diameter_ratio = b.measurement.diameter_ratio;
     m.prune = b.measurement.prune;
+    m.diameter_resolved = b.measurement.diameter_resolved;
     msg.measurements.push_back(m);
   }
   msg.input_points = static_cast<std::uint32_t>(model.input_points);
@@ -121,9 +122,15 @@ visualization_msgs::MarkerArray toMarkers(const modeling::TreeModel& model,
     array.markers.push_back(label(c, header, "trunk_labels"));
   }
   for (const auto& b : model.primary_branches) {
+    // Red: to prune; green: to keep; grey: its diameter was not measured (at the floor).
     const bool prune = b.measurement.prune;
-    array.markers.push_back(cylinderMarker(b.cylinder, header, "primary_branches",
-                                           prune ? 0.9f : 0.1f, prune ? 0.1f : 0.75f, 0.1f));
+    if (!b.measurement.diameter_resolved) {
+      array.markers.push_back(
+          cylinderMarker(b.cylinder, header, "primary_branches", 0.6f, 0.6f, 0.6f));
+    } else {
+      array.markers.push_back(cylinderMarker(b.cylinder, header, "primary_branches",
+                                             prune ? 0.9f : 0.1f, prune ? 0.1f : 0.75f, 0.1f));
+    }
     array.markers.push_back(label(b.cylinder, header, "primary_branch_labels"));
   }
   return array;

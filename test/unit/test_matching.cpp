@@ -58,6 +58,47 @@ std::pair<int, double> bruteForce(const std::vector<std::vector<double>>& cost) 
   return best;
 }
 
+TEST(Evaluate, CountsTheMatchedBranchesWhoseDiameterWasNotMeasured) {
+  // Two branches leaving a 1 m trunk, each detected; the second detection's radius was
+  // corrected to the floor. It still matches and its error counts as reported, and the score
+  // says how many such pairs there are.
+  GroundTruth truth;
+  truth.trunk.points = {{0, 0, 0}, {0, 0, 1}};
+  truth.trunk.diameters = {0.05, 0.04};
+  modeling::TreeModel model;
+  modeling::CylinderModel trunk;
+  trunk.center = {0, 0, 0.5};
+  trunk.diameter = 0.045;
+  trunk.length = 1.0;
+  model.trunk.push_back(trunk);
+  for (int k = 0; k < 2; ++k) {
+    const double z = 0.4 + 0.3 * k, sign = k == 0 ? 1.0 : -1.0;
+    Polyline b;
+    b.id = 10 + k;
+    b.points = {{0, 0, z}, {sign * 0.5, 0, z}};
+    b.diameters = {0.012, 0.012};
+    truth.primary_branches.push_back(b);
+    modeling::PrimaryBranch d;
+    d.cylinder.id = k + 1;
+    d.cylinder.center = {sign * 0.2, 0, z};
+    d.cylinder.axis = {sign, 0, 0};
+    d.cylinder.length = 0.3;
+    d.cylinder.diameter = k == 0 ? 0.011 : 0.004;
+    d.measurement.diameter_resolved = k == 0;
+    model.primary_branches.push_back(d);
+  }
+  const TreeScore s = evaluate(model, truth);
+  EXPECT_EQ(s.tp, 2);
+  EXPECT_EQ(s.unresolved, 1);
+  EXPECT_NEAR(s.branch_mae, 0.5 * (0.001 + 0.008), 1e-12);
+  const std::string details = formatDetails(s, model, truth);
+  EXPECT_EQ(details.find("not measured (floor)"), details.rfind("not measured (floor)"));
+  EXPECT_NE(details.find("d   4.0 mm | truth  11 d  12.0 mm  err  -8.0 mm  e"), std::string::npos)
+      << details;
+  EXPECT_NE(scoresToJson({s}).find("\"unresolved_diameters\": 1"), std::string::npos);
+  EXPECT_EQ(meanScore({s, s}).unresolved, 2);
+}
+
 TEST(Assign, FindsTheMostMatchesAtTheLeastCostLikeBruteForce) {
   Rng rng(11);
   for (int trial = 0; trial < 200; ++trial) {

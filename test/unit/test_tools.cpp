@@ -174,7 +174,7 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
             std::count(trunk.begin(), trunk.end(), ','));
   EXPECT_EQ(trunk.rfind("trunk,0,-1,100.000000", 0), 0u) << trunk;
   EXPECT_NE(branch.find(",90.00,"), std::string::npos) << branch;
-  EXPECT_NE(branch.find(",0.400,0"), std::string::npos) << branch;
+  EXPECT_NE(branch.find(",0.400,0,1"), std::string::npos) << branch;
 }
 
 TEST(RenderModelTool, FarPointsAreSkippedAndAModelThatIsNoTreeIsRefused) {

@@ -38,6 +38,7 @@ modeling::TreeModel sampleModel() {
   b.measurement.trunk_diameter = 0.06;
   b.measurement.diameter_ratio = 0.35;
   b.measurement.prune = false;
+  b.measurement.diameter_resolved = false;
   m.primary_branches.push_back(b);
   return m;
 }
@@ -74,6 +75,7 @@ TEST(ModelJson, RoundTrip) {
   EXPECT_NEAR(b.measurement.angle_to_trunk, M_PI / 2, 1e-12);
   EXPECT_DOUBLE_EQ(b.measurement.diameter_ratio, 0.35);
   EXPECT_FALSE(b.measurement.prune);
+  EXPECT_FALSE(b.measurement.diameter_resolved);
 }
 
 TEST(ModelJson, WritesTheDocumentedKeysAndOffset) {
@@ -91,8 +93,11 @@ TEST(ModelJson, WritesTheDocumentedKeysAndOffset) {
 TEST(ModelJson, ParsesAMinimalForeignDocumentAndNormalisesAxes) {
   const auto m = io::modelFromJson(R"({"format": "dormant_tree_model/1", "units": "m",
     "trunk": [{"id": 3, "center": [0,0,1], "axis": [0,0,2], "diameter": 0.05, "length": 1}],
-    "primary_branches": [], "extra": {"anything": true}})");
+    "primary_branches": [{"id": 4, "center": [0.2,0,1], "axis": [1,0,0], "diameter": 0.01,
+      "length": 0.3}], "extra": {"anything": true}})");
   ASSERT_EQ(m.trunk.size(), 1u);
+  ASSERT_EQ(m.primary_branches.size(), 1u);
+  EXPECT_TRUE(m.primary_branches[0].measurement.diameter_resolved);
   EXPECT_DOUBLE_EQ(m.trunk[0].axis.z(), 1.0);
   EXPECT_EQ(m.trunk[0].num_points, 0u);
 }

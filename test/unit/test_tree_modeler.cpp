@@ -134,9 +134,48 @@ TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
     EXPECT_NEAR(b.measurement.diameter_ratio, b.cylinder.diameter / b.measurement.trunk_diameter,
                 1e-9);
     EXPECT_EQ(b.measurement.prune, b.measurement.diameter_ratio > 0.5);
+    EXPECT_EQ(b.measurement.diameter_resolved,
+              b.cylinder.diameter > 2 * MIN_BRANCH_RADIUS_M + 1e-9);
     EXPECT_GE(b.trunk_segment, 0);
     EXPECT_LT(b.trunk_segment, static_cast<int>(result.model.trunk.size()));
   }
+}
+
+/// The branches a model reports at the diameter floor, checking that each says so and that
+/// the model's warnings count them once (none when there are none).
+std::size_t branchesAtTheFloor(const TreeModel& model) {
+  std::size_t at_floor = 0;
+  for (const auto& b : model.primary_branches) {
+    const bool floor = b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M + 1e-9;
+    EXPECT_EQ(b.measurement.diameter_resolved, !floor) << "branch " << b.cylinder.id;
+    at_floor += floor;
+  }
+  const std::string expected = std::to_string(at_floor) + " of " +
+                               std::to_string(model.primary_branches.size()) +
+                               " branch diameters were not measured";
+  std::size_t counted = 0, found = 0;
+  for (const auto& w : model.correction.warnings) {
+    counted += w.find("were not measured") != std::string::npos;
+    found += w.rfind(expected, 0) == 0;
+  }
+  EXPECT_EQ(counted, at_floor > 0 ? 1u : 0u);
+  EXPECT_EQ(found, at_floor > 0 ? 1u : 0u) << expected;
+  return at_floor;
+}
+
+TEST(TreeModeler, ABranchCorrectedToTheFloorIsNotAMeasurement) {
+  // The correction takes a branch whose RMS radius is all noise to the 4 mm floor: no
+  // measurement, and the model says so per branch and once. Told the noise is 20 mm instead of
+  // the 7.5 mm it estimates, more of this young tree's 5-15 mm branches end there.
+  const Scan scan = scanTree("young_tall_spindle", 3, 0.006);
+  const std::size_t own =
+      branchesAtTheFloor(TreeModeler(test::sensorModelConfig()).model(*scan.cloud).model);
+  ModelerConfig config = test::sensorModelConfig();
+  config.noise.sigma_m = 0.02;
+  const std::size_t told = branchesAtTheFloor(TreeModeler(config).model(*scan.cloud).model);
+  RecordProperty("at_floor_own_estimate", std::to_string(own));
+  RecordProperty("at_floor_told_20mm", std::to_string(told));
+  EXPECT_GT(told, own);
 }
 
 TEST(TreeModeler, ChoosesTheCentredTrunkWhenSomeOfItsTracksStopLow) {

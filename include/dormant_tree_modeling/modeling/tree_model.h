@@ -9,6 +9,10 @@
 namespace dormant_tree_modeling {
 namespace modeling {
 
+/// @brief The least radius a primary branch is given (m): the fits search no thinner, and a
+/// noise correction that would take a radius below it stops there.
+constexpr double MIN_BRANCH_RADIUS_M = 0.002;
+
 /// @brief One fitted cylinder (trunk segment or primary branch), in metres.
 struct CylinderModel {
   int id = 0;                                        ///< unique within one TreeModel
@@ -27,6 +31,10 @@ struct BranchMeasurement {
   double trunk_diameter = 0.0;     ///< m, trunk diameter at the attachment
   double diameter_ratio = 0.0;     ///< branch diameter / trunk_diameter
   bool prune = false;              ///< diameter_ratio above the configured limit
+  /// False when the radius was taken to its floor (MIN_BRANCH_RADIUS_M): the noise the modeler
+  /// corrected for is as wide as the branch, so its diameter was not measured and the diameter,
+  /// ratio and prune flag carry no information about it.
+  bool diameter_resolved = true;
 };
 
 /// @brief A primary branch: its cylinder, the trunk cylinder it leaves, and its measurements.
