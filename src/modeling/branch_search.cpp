@@ -7,8 +7,8 @@
 
 #include "dormant_tree_modeling/modeling/branch_rays.h"
 #include "dormant_tree_modeling/modeling/noise_band.h"
-#include "dormant_tree_modeling/modeling/tree_model.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
 
 namespace dormant_tree_modeling {
 namespace modeling {
@@ -17,7 +17,7 @@ namespace detail {
 namespace {
 
 constexpr double DEG = M_PI / 180.0;
-constexpr double SURFACE_CONTACT = 0.05;     // m beyond inner_gap that still touches the trunk
+constexpr double SURFACE_CONTACT = 0.05;  // m beyond inner_gap that still touches the trunk
 // The paper's search: the RANSAC axis strays up to this far from the guess, and a branch may be
 // as wide as this.
 constexpr double PAPER_MAX_AXIS_DEVIATION = 35.0 * DEG;
@@ -404,8 +404,8 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.axis_candidates = AXIS_CANDIDATES;
   o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
   o.min_radius = MIN_BRANCH_RADIUS_M;
-  o.max_radius =
-      config.fit.constrain ? std::max(MIN_BRANCH_RADIUS_M * 2, seg.radius) : PAPER_MAX_BRANCH_RADIUS;
+  o.max_radius = config.fit.constrain ? std::max(MIN_BRANCH_RADIUS_M * 2, seg.radius)
+                                      : PAPER_MAX_BRANCH_RADIUS;
   o.seed = seed;
   if (!config.fit.constrain) {
     auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);
