@@ -89,7 +89,6 @@ constexpr double FLOOR_TOLERANCE = 1.0 + 1e-6;
 
 /// How far outside a calibration's covered radii and noise a tree may go before the model says
 /// the tables were held constant there: a rod's or a section's neighbourhood.
-constexpr double COVERAGE_RADIUS_SLACK = 0.15;
 constexpr double COVERAGE_NOISE_SLACK = 0.25;
 
 std::string outsideRange(const char* what, const std::vector<double>& radii, double lo, double hi) {

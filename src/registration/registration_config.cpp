@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 
 #include "dormant_tree_modeling/common/config_table.h"
@@ -188,6 +189,13 @@ bool applySensorCalibration(const modeling::SensorCalibration& calibration,
   config.axes.silhouette_growth_m = s.depth_share * s.growth_m;
   config.axes.silhouette_growth_per_m = s.depth_share * s.growth_per_m;
   config.axes.silhouette_diameter_gain = s.diameter_gain;
+  // The silhouette model was measured on the rig's rods: a thicker branch's silhouette is
+  // beyond it, and beyond what an axis sample's patch holds whole.
+  const double rods = calibration.coverage.branch_radius_max_m;
+  if (rods > 0.0) {
+    config.axes.max_radius_m =
+        std::min(config.axes.max_radius_m, rods * (1.0 + modeling::COVERAGE_RADIUS_SLACK));
+  }
   return true;
 }
 

@@ -9,6 +9,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/registration/branch_axes.h"
 #include "dormant_tree_modeling/registration/icp.h"
+#include "dormant_tree_modeling/registration/multi_view.h"
 
 namespace dormant_tree_modeling {
 namespace registration {
@@ -83,6 +84,47 @@ TEST(BranchAxes, FindTheAxisFromEitherSide) {
       EXPECT_GT(std::abs(a.directions[i].dot(stick.axis)), 0.999);
       EXPECT_GT(a.view_dirs[i].y() * side, 0.99);  // towards the sensor
     }
+  }
+}
+
+TEST(BranchAxes, BranchesThickerThanTheCalibratedRodsGiveNoSamples) {
+  // A sample is centred on one of the station's points, on the visible surface: from near one
+  // edge of a 35 mm branch the far edge lies beyond the 10 cm patch, and the cut silhouette
+  // reads thin with its axis too near the sensor. A calibration whose rods reach 20 mm keeps
+  // samples to 23 mm (COVERAGE_RADIUS_SLACK): the thick branch gives none, a 15 mm one still
+  // gives its axis.
+  const Stick thick{{0.0, 0.0, 1.5}, {1, 0, 0}, 0.035, 0.5};
+  const Stick thin{{0.0, 0.0, 1.5}, {1, 0, 0}, 0.015, 0.5};
+  auto surfaceCentres = [](const Stick& s) {
+    Points centres;
+    for (const double x : {-0.8, -0.5, 0.5, 0.8})
+      centres.emplace_back(0.0, -std::sqrt(1.0 - x * x) * s.radius, 1.5 + x * s.radius);
+    return centres;
+  };
+  const HalfView v = seeHalves({thick}, {0.0, -2.0, 1.5}, 0.0, 1);
+  const AxisSamples uncovered =
+      estimateAxes(v.points, v.view_dirs, v.ranges, surfaceCentres(thick), idealBeams());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < uncovered.size(); ++i)
+    worst = std::max(worst, offAxis(thick, uncovered.points[i]));
+  EXPECT_GT(worst, 0.004) << "without a radius limit the cut silhouettes sit off the axis";
+
+  modeling::SensorCalibration calibration;
+  calibration.name = "ideal rig";
+  calibration.silhouette.measured = true;
+  calibration.coverage.branch_radius_min_m = 0.002;
+  calibration.coverage.branch_radius_max_m = 0.02;
+  RegistrationConfig config;
+  ASSERT_TRUE(applySensorCalibration(calibration, config));
+  EXPECT_EQ(
+      estimateAxes(v.points, v.view_dirs, v.ranges, surfaceCentres(thick), config.axes).size(), 0u);
+  const HalfView w = seeHalves({thin}, {0.0, -2.0, 1.5}, 0.0, 1);
+  const AxisSamples kept =
+      estimateAxes(w.points, w.view_dirs, w.ranges, surfaceCentres(thin), config.axes);
+  ASSERT_EQ(kept.size(), 4u);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_NEAR(kept.radii[i], thin.radius, 0.002);
+    EXPECT_LT(offAxis(thin, kept.points[i]), 0.002);
   }
 }
 

@@ -129,11 +129,14 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_TRUE(registration::applySensorCalibration(back, reg));
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.5 * 0.0015);
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_diameter_gain, 0.4);
+  // Axis samples stay within the rods' radii the calibration covers (0.02 m, + 15 %).
+  EXPECT_DOUBLE_EQ(reg.axes.max_radius_m, 0.02 * (1.0 + modeling::COVERAGE_RADIUS_SLACK));
   modeling::SensorCalibration without = back;
   without.silhouette = {};
   registration::RegistrationConfig ideal;
   EXPECT_FALSE(registration::applySensorCalibration(without, ideal));
   EXPECT_DOUBLE_EQ(ideal.axes.silhouette_growth_per_m, 0.0);
+  EXPECT_DOUBLE_EQ(ideal.axes.max_radius_m, registration::AxisConfig{}.max_radius_m);
   auto code = [&](const std::string& text) {
     try {
       modeling::loadSensorCalibration(dir.write("bad.yaml", text));

@@ -17,6 +17,11 @@ struct CalibrationCoverage {
   double noise_min_m = 0.0, noise_max_m = 0.0;
 };
 
+/// @brief How far beyond the radii a calibration covers (a share of them) it is still used as
+/// measured: about a rod's or a section's neighbourhood. Beyond, the modeler warns that its
+/// tables were held constant, and the registration drops branch-axis samples.
+constexpr double COVERAGE_RADIUS_SLACK = 0.15;
+
 /// @brief The range of a silhouette's diameter gain (SensorCalibration::Silhouette). Below
 /// the minimum a width tells diameters apart too little: a radius read from it would carry
 /// more than 5 times the width's noise.
