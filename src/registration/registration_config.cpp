@@ -72,7 +72,8 @@ ConfigTable<AxisConfig> makeAxisTable() {
       .add("min_radius_m", &A::min_radius_m, 0.0, 1.0, "Thinner samples are dropped.")
       .formerly("axis_min_radius")
       .add("max_radius_m", &A::max_radius_m, 0.001, 1.0,
-           "Thicker samples are dropped (trunk or fork: plain point pairs serve there).")
+           "Thicker samples are dropped (trunk or fork: plain point pairs serve there). A "
+           "calibration lowers it to its largest rod's radius + 15 %.")
       .formerly("axis_max_radius");
   return t;
 }
