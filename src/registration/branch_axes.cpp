@@ -70,6 +70,8 @@ std::optional<Sample> fitPatch(const Points& pts, const Points& view_dirs,
   const double mid = sum / n;
   const double width = std::sqrt(12.0 * std::max(sum_sq / n - mid * mid, 0.0));
   const double range = median(patch_ranges);
+  if (c.max_width_m > 0.0 && width > c.max_width_m + c.max_width_per_m * range)
+    return std::nullopt;
   const double radius = 0.5 * (width - c.silhouette_growth_m - c.silhouette_growth_per_m * range) /
                         c.silhouette_diameter_gain;
   if (!(radius >= c.min_radius_m && radius <= c.max_radius_m))

@@ -72,8 +72,7 @@ ConfigTable<AxisConfig> makeAxisTable() {
       .add("min_radius_m", &A::min_radius_m, 0.0, 1.0, "Thinner samples are dropped.")
       .formerly("axis_min_radius")
       .add("max_radius_m", &A::max_radius_m, 0.001, 1.0,
-           "Thicker samples are dropped (trunk or fork: plain point pairs serve there). A "
-           "calibration lowers it to its largest rod's radius + 15 %.")
+           "Thicker samples are dropped (trunk or fork: plain point pairs serve there).")
       .formerly("axis_max_radius");
   return t;
 }
@@ -163,6 +162,11 @@ void AxisConfig::validate() const {
   axisConfigTable().require(
       std::abs(silhouette_growth_m) <= 0.05 && std::abs(silhouette_growth_per_m) <= 0.05,
       "silhouette growth (from the calibration) must be within ±0.05 m and ±0.05 m per m");
+  // The limit is the growth's line scaled, so its slope may be as small and negative as a
+  // fitted growth per m.
+  axisConfigTable().require(max_width_m >= 0.0 && std::abs(max_width_per_m) <= 0.1,
+                            "silhouette width limit (from the calibration) must be at least 0 m "
+                            "and within ±0.1 m per m");
   axisConfigTable().require(modeling::validDiameterGain(silhouette_diameter_gain),
                             "silhouette diameter gain (from the calibration) must be within " +
                                 modeling::diameterGainRange());
@@ -190,12 +194,13 @@ bool applySensorCalibration(const modeling::SensorCalibration& calibration,
   config.axes.silhouette_growth_m = s.depth_share * s.growth_m;
   config.axes.silhouette_growth_per_m = s.depth_share * s.growth_per_m;
   config.axes.silhouette_diameter_gain = s.diameter_gain;
-  // The silhouette model was measured on the rig's rods: a thicker branch's silhouette is
-  // beyond it, and beyond what an axis sample's patch holds whole.
+  // The silhouette model was measured on the rig's rods: a wider silhouette is beyond it, and
+  // beyond what an axis sample's patch holds whole.
   const double rods = calibration.coverage.branch_radius_max_m;
   if (rods > 0.0) {
-    config.axes.max_radius_m =
-        std::min(config.axes.max_radius_m, rods * (1.0 + modeling::COVERAGE_RADIUS_SLACK));
+    const double slack = 1.0 + modeling::COVERAGE_RADIUS_SLACK;
+    config.axes.max_width_m = slack * (2.0 * s.diameter_gain * rods + s.growth_m);
+    config.axes.max_width_per_m = slack * s.growth_per_m;
   }
   return true;
 }

@@ -90,9 +90,9 @@ TEST(BranchAxes, FindTheAxisFromEitherSide) {
 TEST(BranchAxes, BranchesThickerThanTheCalibratedRodsGiveNoSamples) {
   // A sample is centred on one of the station's points, on the visible surface: from near one
   // edge of a 35 mm branch the far edge lies beyond the 10 cm patch, and the cut silhouette
-  // reads thin with its axis too near the sensor. A calibration whose rods reach 20 mm keeps
-  // samples to 23 mm (COVERAGE_RADIUS_SLACK): the thick branch gives none, a 15 mm one still
-  // gives its axis.
+  // reads thin with its axis too near the sensor. An ideal beam's calibration whose rods reach
+  // 20 mm keeps silhouettes to 46 mm wide (COVERAGE_RADIUS_SLACK): the thick branch gives
+  // none, a 15 mm one still gives its axis.
   const Stick thick{{0.0, 0.0, 1.5}, {1, 0, 0}, 0.035, 0.5};
   const Stick thin{{0.0, 0.0, 1.5}, {1, 0, 0}, 0.015, 0.5};
   auto surfaceCentres = [](const Stick& s) {

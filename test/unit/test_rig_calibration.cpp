@@ -129,14 +129,17 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_TRUE(registration::applySensorCalibration(back, reg));
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.5 * 0.0015);
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_diameter_gain, 0.4);
-  // Axis samples stay within the rods' radii the calibration covers (0.02 m, + 15 %).
-  EXPECT_DOUBLE_EQ(reg.axes.max_radius_m, 0.02 * (1.0 + modeling::COVERAGE_RADIUS_SLACK));
+  // Axis samples stay within the silhouettes of the rods the calibration covers (up to 0.02 m
+  // radius), 15 % wider.
+  const double slack = 1.0 + modeling::COVERAGE_RADIUS_SLACK;
+  EXPECT_DOUBLE_EQ(reg.axes.max_width_m, slack * (2 * 0.4 * 0.02 + 0.0015));
+  EXPECT_DOUBLE_EQ(reg.axes.max_width_per_m, slack * 0.0085);
   modeling::SensorCalibration without = back;
   without.silhouette = {};
   registration::RegistrationConfig ideal;
   EXPECT_FALSE(registration::applySensorCalibration(without, ideal));
   EXPECT_DOUBLE_EQ(ideal.axes.silhouette_growth_per_m, 0.0);
-  EXPECT_DOUBLE_EQ(ideal.axes.max_radius_m, registration::AxisConfig{}.max_radius_m);
+  EXPECT_DOUBLE_EQ(ideal.axes.max_width_m, 0.0);
   auto code = [&](const std::string& text) {
     try {
       modeling::loadSensorCalibration(dir.write("bad.yaml", text));

@@ -38,6 +38,13 @@ struct AxisConfig {
   /// How much of a diameter change the width shows (the calibration's diameter_gain): the
   /// radius is half the width less the growth, divided by it. 1: an ideal beam's.
   double silhouette_diameter_gain = 1.0;
+  /// Samples whose silhouette is wider than max_width_m + max_width_per_m x range are dropped:
+  /// the widths the calibration's rods showed (its largest rod's, + COVERAGE_RADIUS_SLACK).
+  /// Its silhouette model holds there, and a sample centred on the visible surface holds a
+  /// wider silhouette only in part (its patch cuts it: read thin, its axis too near the
+  /// sensor). 0 and 0: no limit (no calibration).
+  double max_width_m = 0.0;
+  double max_width_per_m = 0.0;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };

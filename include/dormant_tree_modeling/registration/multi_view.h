@@ -50,9 +50,10 @@ const ConfigTable<CoarseSearchConfig>& coarseSearchConfigTable();
 RegistrationConfig loadRegistrationConfig(const std::string& path);
 
 /// @brief Take the silhouette growth of the branch axes from a sensor calibration, and keep
-/// axis samples within the rod radii it covers (COVERAGE_RADIUS_SLACK beyond its largest rod):
-/// the growth was measured on those rods, and a branch much thicker than the patch's half
-/// (AxisConfig::patch_m) shows a silhouette the patch cuts, read thin and too near its sensor.
+/// axis samples within the silhouette widths its rods showed (AxisConfig::max_width_m: its
+/// largest rod's, COVERAGE_RADIUS_SLACK wider): the growth was measured on those rods, and a
+/// silhouette wider than about half the patch (AxisConfig::patch_m) is cut by it, read thin
+/// and too near its sensor.
 /// @return false (config unchanged: an ideal beam) when the calibration has no silhouette
 bool applySensorCalibration(const modeling::SensorCalibration& calibration,
                             RegistrationConfig& config);
