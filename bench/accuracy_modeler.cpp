@@ -275,10 +275,9 @@ int main(int argc, char** argv) {
     }
   }
   std::cout << "\n=== summary: F1, branch diameter MAE (bias) in mm, the share of matched branches "
-               "whose diameter was not measured (corrected to the floor), trunk MAE in mm; targets "
-               "with the "
-               "rig's calibration: branch MAE <= 3 mm and |bias| <= 1 mm at 3 and 6 mm, <= 4.5 "
-               "mm at 12 mm; trunk MAE <= 2.5 mm; F1 >= 98% ===\n";
+               "whose diameter was not measured (corrected to the floor), trunk MAE in mm; "
+               "targets with the rig's calibration: branch MAE <= 3 mm and |bias| <= 1 mm at 3 "
+               "and 6 mm, <= 4.5 mm at 12 mm; trunk MAE <= 2.5 mm; F1 >= 98% ===\n";
   for (const auto& l : lines)
     std::cout << l << "\n";
   return 0;

@@ -176,6 +176,7 @@ DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeMod
     d.warnings.push_back(floor);
   return d;
 }
+
 /// Drops non-finite points (a copy only when there are some: a whole scan is hundreds of MB)
 /// and preprocesses the rest into result->points, ->preprocess and ->notices.
 /// @throws Error EMPTY_INPUT with fewer than MIN_POINTS before or after
