@@ -124,13 +124,10 @@ visualization_msgs::MarkerArray toMarkers(const modeling::TreeModel& model,
   for (const auto& b : model.primary_branches) {
     // Red: to prune; green: to keep; grey: its diameter was not measured (at the floor).
     const bool prune = b.measurement.prune;
-    if (!b.measurement.diameter_resolved) {
-      array.markers.push_back(
-          cylinderMarker(b.cylinder, header, "primary_branches", 0.6f, 0.6f, 0.6f));
-    } else {
-      array.markers.push_back(cylinderMarker(b.cylinder, header, "primary_branches",
-                                             prune ? 0.9f : 0.1f, prune ? 0.1f : 0.75f, 0.1f));
-    }
+    float r = prune ? 0.9f : 0.1f, g = prune ? 0.1f : 0.75f, blue = 0.1f;
+    if (!b.measurement.diameter_resolved)
+      r = g = blue = 0.6f;
+    array.markers.push_back(cylinderMarker(b.cylinder, header, "primary_branches", r, g, blue));
     array.markers.push_back(label(b.cylinder, header, "primary_branch_labels"));
   }
   return array;

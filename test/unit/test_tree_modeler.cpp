@@ -89,6 +89,28 @@ Scan scanTree(const std::string& preset, std::uint64_t seed, double noise) {
   return s;
 }
 
+/// The branches a model reports at the diameter floor, checking that each says so and that
+/// the model's warnings count them once (none when there are none).
+std::size_t branchesAtTheFloor(const TreeModel& model) {
+  std::size_t at_floor = 0;
+  for (const auto& b : model.primary_branches) {
+    const bool floor = b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M + 1e-9;
+    EXPECT_EQ(b.measurement.diameter_resolved, !floor) << "branch " << b.cylinder.id;
+    at_floor += floor;
+  }
+  const std::string expected = std::to_string(at_floor) + " of " +
+                               std::to_string(model.primary_branches.size()) +
+                               " branch diameters were not measured";
+  std::size_t counted = 0, found = 0;
+  for (const auto& w : model.correction.warnings) {
+    counted += w.find("were not measured") != std::string::npos;
+    found += w.rfind(expected, 0) == 0;
+  }
+  EXPECT_EQ(counted, at_floor > 0 ? 1u : 0u);
+  EXPECT_EQ(found, at_floor > 0 ? 1u : 0u) << expected;
+  return at_floor;
+}
+
 TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
   const Scan scan = scanTree("young_tall_spindle", 3, 0.006);
   const TreeModeler modeler(test::sensorModelConfig());
@@ -129,38 +151,15 @@ TEST(TreeModeler, SyntheticTreeMeetsAccuracyBounds) {
   trunk_error /= std::max<std::size_t>(1, result.model.primary_branches.size());
   RecordProperty("trunk_diameter_at_branches_mae_mm", std::to_string(1000 * trunk_error));
   EXPECT_LE(trunk_error, 0.003);
-  // Measurements are consistent with the cylinders.
+  // Measurements are consistent with the cylinders, and a diameter at the floor says so.
+  branchesAtTheFloor(result.model);
   for (const auto& b : result.model.primary_branches) {
     EXPECT_NEAR(b.measurement.diameter_ratio, b.cylinder.diameter / b.measurement.trunk_diameter,
                 1e-9);
     EXPECT_EQ(b.measurement.prune, b.measurement.diameter_ratio > 0.5);
-    EXPECT_EQ(b.measurement.diameter_resolved,
-              b.cylinder.diameter > 2 * MIN_BRANCH_RADIUS_M + 1e-9);
     EXPECT_GE(b.trunk_segment, 0);
     EXPECT_LT(b.trunk_segment, static_cast<int>(result.model.trunk.size()));
   }
-}
-
-/// The branches a model reports at the diameter floor, checking that each says so and that
-/// the model's warnings count them once (none when there are none).
-std::size_t branchesAtTheFloor(const TreeModel& model) {
-  std::size_t at_floor = 0;
-  for (const auto& b : model.primary_branches) {
-    const bool floor = b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M + 1e-9;
-    EXPECT_EQ(b.measurement.diameter_resolved, !floor) << "branch " << b.cylinder.id;
-    at_floor += floor;
-  }
-  const std::string expected = std::to_string(at_floor) + " of " +
-                               std::to_string(model.primary_branches.size()) +
-                               " branch diameters were not measured";
-  std::size_t counted = 0, found = 0;
-  for (const auto& w : model.correction.warnings) {
-    counted += w.find("were not measured") != std::string::npos;
-    found += w.rfind(expected, 0) == 0;
-  }
-  EXPECT_EQ(counted, at_floor > 0 ? 1u : 0u);
-  EXPECT_EQ(found, at_floor > 0 ? 1u : 0u) << expected;
-  return at_floor;
 }
 
 TEST(TreeModeler, ABranchCorrectedToTheFloorIsNotAMeasurement) {
