@@ -121,6 +121,13 @@ std::optional<Circle> robustCircle(const Points2& pts, const Circle& start, doub
   return c;
 }
 
+namespace {
+bool withinBounds(const Circle& c, const CircleRansacConfig& o) {
+  return c.radius >= o.min_radius && c.radius <= o.max_radius &&
+         c.center.norm() <= o.max_center_offset;
+}
+}  // namespace
+
 std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacConfig& o,
                                    std::vector<int>* inliers) {
   const int n = static_cast<int>(pts.size());
@@ -136,7 +143,7 @@ std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacConfig&
     if (i == j || j == k || i == k)
       continue;
     const auto c = circleThrough(pts[i], pts[j], pts[k]);
-    if (!c || c->radius < o.min_radius || c->radius > o.max_radius)
+    if (!c || !withinBounds(*c, o))
       continue;
     // Inliers from squared distances (a root only for the inliers' cost); a hypothesis that can
     // no longer reach the best count is left early. Same choice as scoring every point.
@@ -178,7 +185,7 @@ std::optional<Circle> ransacCircle(const Points2& pts, const CircleRansacConfig&
         sub.push_back(p);
     }
     const auto refined = fitCircle(sub);
-    if (!refined || refined->radius < o.min_radius || refined->radius > o.max_radius)
+    if (!refined || !withinBounds(*refined, o))
       break;
     best = refined;
   }

@@ -240,6 +240,7 @@ struct TrunkRegion {
   std::vector<int> points;            ///< indices of the trunk region's points, sorted
   std::vector<Eigen::Vector3d> axis;  ///< initial centreline, bottom to top
   double radius = 0.0;                ///< typical trunk radius (m), 0 when unknown
+  std::vector<double> radii;          ///< the radius at each axis point, when tracked
 };
 
 /// Algorithm 3's trunk region: the trunk and primary-branch clusters, the trunk clusters'
@@ -414,11 +415,13 @@ ModelResult TreeModeler::model(const Points& input) const {
             trackBestTrunk(pts, index, clusters, path, config_, &result.trunk_candidates)) {
       region.axis = tracked->centers;
       region.radius = median(tracked->radii);
+      region.radii = tracked->radii;
       region.points = pointsNearAxis(pts, region.axis, trunkReach(region.radius));
     }
   }
   watch.lap("track");
-  const TrunkModel trunk = modelTrunk(pts, region.points, region.axis, region.radius, config_);
+  const TrunkModel trunk =
+      modelTrunk(pts, region.points, region.axis, region.radius, config_, region.radii);
   result.noise_sigma = trunk.noise_sigma;
   result.table_noise_sigma = trunk.table_sigma;
   watch.lap("trunk");

@@ -41,12 +41,50 @@ constexpr double TAPER_ABOVE = 2.0;
 // slices' scatter: only slices within one robust sigma above the profile stay in its fit.
 constexpr double TAPER_NOISY_SIGMA = 0.010;
 constexpr double TAPER_ABOVE_NOISY = 1.0;
+// Arc length (m) either side of a slice over which the track's radii give its local radius:
+// three slices, as the running median of expectedRadii.
+constexpr double AXIS_RADIUS_WINDOW = 0.15;
+// A slice circle's centre lies within this many local radii of the centreline: the circle
+// holds the axis.
+constexpr double SLICE_CENTRE_RADII = 1.0;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
   double min_radius = MIN_TRUNK_RADIUS;
   double max_radius = MAX_TRUNK_RADIUS;
   double max_distance = 1e300;
+};
+
+/// The trunk's track: its axis and the radii it measured along it. A slice continues it: a
+/// trunk tapers to a half or a third of its base radius, and one radius for the whole trunk
+/// lets the thin top's slices take circles around the leader and a scaffold beside it.
+class TrackedAxis {
+ public:
+  /// @param line the track's axis; radii: one per vertex of `axis`, or none (no track)
+  TrackedAxis(Centerline line, const std::vector<Eigen::Vector3d>& axis,
+              const std::vector<double>& radii)
+      : line_(std::move(line)) {
+    for (std::size_t i = 0; i < axis.size() && i < radii.size(); ++i)
+      samples_.emplace_back(line_.project(axis[i]), radii[i]);
+  }
+  bool empty() const { return samples_.empty(); }
+  /// The median of the track's radii within AXIS_RADIUS_WINDOW of the track point nearest p;
+  /// 0 where there are none.
+  double radiusNear(const Eigen::Vector3d& p) const {
+    if (samples_.empty())
+      return 0.0;
+    const double s = line_.project(p);
+    std::vector<double> r;
+    for (const auto& [t, radius] : samples_) {
+      if (std::abs(t - s) <= AXIS_RADIUS_WINDOW)
+        r.push_back(radius);
+    }
+    return r.empty() ? 0.0 : median(r);
+  }
+
+ private:
+  Centerline line_;
+  std::vector<std::pair<double, double>> samples_;  // arc length on line_, radius
 };
 
 /// Indices of the points within `window` (m) of `centre`.
@@ -110,7 +148,7 @@ namespace {
 std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
                                  const Centerline& line, const std::vector<double>& s,
                                  const std::vector<double>& dist, double height, double threshold,
-                                 const SliceBounds& bounds,
+                                 const SliceBounds& bounds, const TrackedAxis& track,
                                  const std::vector<double>* expected_radius, double continuity,
                                  std::optional<double> calibrate_at, const ModelerConfig& config) {
   double lo = 1e300, hi = -1e300;
@@ -140,6 +178,7 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     }
     const double mid = sl.s0 + 0.5 * height;
     const Eigen::Vector3d origin = line.pointAt(mid), dir = line.directionAt(mid);
+    const double local_radius = track.radiusNear(origin);
     const Eigen::Vector3d u = dir.unitOrthogonal(), v = dir.cross(u);
     Points2 plane;
     for (const int i : members[n])
@@ -149,14 +188,20 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
     o.iterations = config.fit.ransac_iterations;
     o.min_radius = bounds.min_radius;
     o.max_radius = bounds.max_radius;
+    if (local_radius > 0.0) {
+      o.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * local_radius);
+      o.max_radius = std::min(MAX_TRUNK_RADIUS, SLICE_MAX_RADIUS_SHARE * local_radius);
+      o.max_center_offset = SLICE_CENTRE_RADII * local_radius;
+    }
+    const double min_radius = o.min_radius, max_radius = o.max_radius;
     if (expected_radius && (*expected_radius)[n] > 0.0) {
-      o.min_radius = std::max(bounds.min_radius, (*expected_radius)[n] * (1.0 - continuity));
-      o.max_radius = std::min(bounds.max_radius, (*expected_radius)[n] * (1.0 + continuity));
+      o.min_radius = std::max(min_radius, (*expected_radius)[n] * (1.0 - continuity));
+      o.max_radius = std::min(max_radius, (*expected_radius)[n] * (1.0 + continuity));
     }
 
     o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
-    const auto measured = measureSliceCircle(plane, o, config.noise.correct_bias, bounds.min_radius,
-                                             bounds.max_radius);
+    const auto measured =
+        measureSliceCircle(plane, o, config.noise.correct_bias, min_radius, max_radius);
     sl.outliers = sl.points - (measured ? measured->inliers : 0);
     sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
     if (measured && measured->inliers >= MIN_SLICE_POINTS / 2) {
@@ -781,31 +826,63 @@ void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
   }
 }
 
+/// A centreline refined on its slice circles and the slices about it.
+struct SlicedAxis {
+  Centerline line;
+  std::vector<double> s, dist;  ///< each region point's arc length and distance from the line
+  std::vector<Slice> slices;
+};
+
+/// Slices on the initial axis, then CENTERLINE_ROUNDS rounds of refining the centreline on
+/// their circles and slicing again.
+SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
+                         const Centerline& initial, const SliceBounds& bounds,
+                         const TrackedAxis& track, double initial_radius,
+                         const ModelerConfig& config) {
+  const double h = config.trunk.slice_height_m;
+  SlicedAxis out{
+      initial, std::vector<double>(region.size()), std::vector<double>(region.size()), {}};
+  for (int round = 0; round <= CENTERLINE_ROUNDS; ++round) {
+    if (round > 0)
+      out.line = refineCenterline(out.slices, out.line,
+                                  std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
+    projectRegion(pts, region, out.line, out.s, out.dist);
+    out.slices =
+        computeSlices(pts, region, out.line, out.s, out.dist, h, config.fit.circle_threshold_m,
+                      bounds, track, nullptr, 0.0, std::nullopt, config);
+  }
+  return out;
+}
+
 }  // namespace
 
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
-                      const ModelerConfig& config) {
+                      const ModelerConfig& config, const std::vector<double>& axis_radii) {
   if (initial_axis.size() < 2 || region.size() < static_cast<std::size_t>(MIN_SLICE_POINTS)) {
     throw Error(ErrorCode::NO_TRUNK, "no trunk: too few trunk points to model");
   }
   TrunkModel trunk;
   const double h = config.trunk.slice_height_m;
-  Centerline line(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
-  std::vector<double> s(region.size()), dist(region.size());
-  projectRegion(pts, region, line, s, dist);
+  const Centerline initial(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   const SliceBounds bounds = sliceBounds(initial_radius);
-  // Slices on the initial axis refine the centreline; then the noise is estimated.
-  auto slices = computeSlices(pts, region, line, s, dist, h, config.fit.circle_threshold_m, bounds,
-                              nullptr, 0.0, std::nullopt, config);
-  for (int round = 0; round < CENTERLINE_ROUNDS; ++round) {
-    line = refineCenterline(slices, line, std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
-    projectRegion(pts, region, line, s, dist);
-    slices = computeSlices(pts, region, line, s, dist, h, config.fit.circle_threshold_m, bounds,
-                           nullptr, 0.0, std::nullopt, config);
-  }
+  const TrackedAxis track(initial, initial_axis, axis_radii);
+  // The noise is read on slices bounded by the trunk-wide radius alone and about their own
+  // centreline, with or without a track: the calibrations' noise rows and the branch search's
+  // bands were set on that reading, and a thin branch's noise correction follows it about
+  // one for one.
+  const SlicedAxis unbounded = refinedSlices(pts, region, initial, bounds,
+                                             TrackedAxis(initial, {}, {}), initial_radius, config);
+  SlicedAxis sliced =
+      track.empty() ? unbounded
+                    : refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
+  Centerline& line = sliced.line;
+  std::vector<double>& s = sliced.s;
+  std::vector<double>& dist = sliced.dist;
+  std::vector<Slice>& slices = sliced.slices;
   std::vector<double> slice_radii;
-  const double sigma = trunkNoise(pts, region, line, slices, config, &slice_radii);
+  const double sigma =
+      trunkNoise(pts, region, unbounded.line, unbounded.slices, config, &slice_radii);
   trunk.noise_sigma = sigma;
   // A calibration's rows are the estimate as its rig read it (raw radii: calibrate_diameters
   // measuring one), and take the tree's likewise; the noise part alone models range noise, and
@@ -825,7 +902,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   if (config.fit.constrain || config.noise.derive_parameters || config.noise.correct_bias) {
     const auto expected = expectedRadii(slices);
-    slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds,
+    slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds, track,
                            config.fit.constrain ? &expected : nullptr,
                            config.trunk.radius_continuity, trunk.table_sigma, config);
   }

@@ -120,6 +120,29 @@ TEST(Circle, RansacIgnoresOutliersAndRespectsBounds) {
   }
 }
 
+TEST(Circle, RansacKeepsItsCentreNearTheOrigin) {
+  // A ring of 300 points 10 cm from the origin, and a ring of 100 about it.
+  Points2 pts;
+  for (int i = 0; i < 300; ++i) {
+    const double a = 2.0 * M_PI * i / 300;
+    pts.emplace_back(0.1 + 0.03 * std::cos(a), 0.03 * std::sin(a));
+  }
+  for (int i = 0; i < 100; ++i) {
+    const double a = 2.0 * M_PI * i / 100;
+    pts.emplace_back(0.02 * std::cos(a), 0.02 * std::sin(a));
+  }
+  CircleRansacConfig o;
+  o.threshold = 0.002;
+  const auto far = ransacCircle(pts, o);
+  ASSERT_TRUE(far);
+  EXPECT_NEAR(far->center.x(), 0.1, 0.001) << "the ring with the most points";
+  o.max_center_offset = 0.01;
+  const auto near = ransacCircle(pts, o);
+  ASSERT_TRUE(near);
+  EXPECT_LT(near->center.norm(), 0.001);
+  EXPECT_NEAR(near->radius, 0.02, 0.001);
+}
+
 TEST(Cylinder, LeastSquaresRecoversAnInclinedCylinder) {
   const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
   const Points pts = cylinderPoints({1, 2, 0}, axis, 0.04, 0.5, 400, 0.0, 1);

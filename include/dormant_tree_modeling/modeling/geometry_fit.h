@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -61,6 +62,8 @@ struct CircleRansacConfig {
   int iterations = 200;
   double min_radius = 0.001;  ///< m
   double max_radius = 1.0;    ///< m
+  /// m: the centre lies at most this far from the origin (a slice's centreline point)
+  double max_center_offset = std::numeric_limits<double>::infinity();
   std::uint64_t seed = 1;
 };
 

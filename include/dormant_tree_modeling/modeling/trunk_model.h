@@ -160,10 +160,14 @@ inline double trunkReach(double radius) {
 ///        smoothed by a robust cubic fit)
 /// @param initial_radius typical trunk radius (e.g. median of the trunk clusters' fits), or 0;
 ///        slice circles stay within 0.3x..2.5x of it
+/// @param axis_radii the radius measured at each initial axis point (a track's circles), or
+///        none; where given, a slice's circle stays within 0.3x..2.5x of the median of the
+///        radii within 15 cm of it, and its centre within one such radius of the centreline
+///        (the noise estimate still reads slices bounded by initial_radius alone)
 /// @throws Error NO_TRUNK when no trunk cylinder can be fitted
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
-                      const ModelerConfig& config);
+                      const ModelerConfig& config, const std::vector<double>& axis_radii = {});
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling
