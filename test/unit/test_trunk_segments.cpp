@@ -36,17 +36,27 @@ Points taperedTrunk() {
   return pts;
 }
 
-TrunkModel modelTapered(double max_segment_length) {
-  const Points pts = taperedTrunk();
+/// Every point of the cloud as the trunk region.
+std::vector<int> allOf(const Points& pts) {
   std::vector<int> region(pts.size());
   std::iota(region.begin(), region.end(), 0);
+  return region;
+}
+
+/// No beam, no noise: the sensor model's diameter calibration does not apply.
+ModelerConfig idealScanner() {
   ModelerConfig config;
-  // No beam, no noise: the sensor model's diameter calibration does not apply.
   config.noise.sigma_m = 0.0;
   config.noise.beam_spread_m = 0.0;
   config.trunk_calibration = RadiusCalibration{};
+  return config;
+}
+
+TrunkModel modelTapered(double max_segment_length) {
+  const Points pts = taperedTrunk();
+  ModelerConfig config = idealScanner();
   config.trunk.max_segment_length_m = max_segment_length;
-  return modelTrunk(pts, region, {{0, 0, 0}, {0, 0, HEIGHT}}, 0.05, config);
+  return modelTrunk(pts, allOf(pts), {{0, 0, 0}, {0, 0, HEIGHT}}, 0.05, config);
 }
 
 /// The largest difference between a segment's radius and the trunk's at the segment's ends.
@@ -149,12 +159,8 @@ double worstAboveTheRods(const TrunkModel& trunk) {
 
 TEST(TrunkSegments, SlicesFollowTheTrackedRadiusPastScaffoldsAroundTheTop) {
   const Points pts = trunkWithRodsAroundItsTop();
-  std::vector<int> region(pts.size());
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise.sigma_m = 0.0;
-  config.noise.beam_spread_m = 0.0;
-  config.trunk_calibration = RadiusCalibration{};
+  const std::vector<int> region = allOf(pts);
+  const ModelerConfig config = idealScanner();
   // A track's circles along the axis: the taper, 5 cm apart.
   std::vector<Eigen::Vector3d> axis;
   std::vector<double> radii;
