@@ -60,6 +60,7 @@ struct SliceBounds {
 /// lets the thin top's slices take circles around the leader and a scaffold beside it.
 class TrackedAxis {
  public:
+  TrackedAxis() = default;  ///< no track: slices keep the trunk-wide bounds
   /// @param line the track's axis; radii: one per vertex of `axis`, or none (no track)
   TrackedAxis(Centerline line, const std::vector<Eigen::Vector3d>& axis,
               const std::vector<double>& radii)
@@ -871,18 +872,16 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   // centreline, with or without a track: the calibrations' noise rows and the branch search's
   // bands were set on that reading, and a thin branch's noise correction follows it about
   // one for one.
-  const SlicedAxis unbounded = refinedSlices(pts, region, initial, bounds,
-                                             TrackedAxis(initial, {}, {}), initial_radius, config);
   SlicedAxis sliced =
-      track.empty() ? unbounded
-                    : refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
+      refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
+  std::vector<double> slice_radii;
+  const double sigma = trunkNoise(pts, region, sliced.line, sliced.slices, config, &slice_radii);
+  if (!track.empty())
+    sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
   Centerline& line = sliced.line;
   std::vector<double>& s = sliced.s;
   std::vector<double>& dist = sliced.dist;
   std::vector<Slice>& slices = sliced.slices;
-  std::vector<double> slice_radii;
-  const double sigma =
-      trunkNoise(pts, region, unbounded.line, unbounded.slices, config, &slice_radii);
   trunk.noise_sigma = sigma;
   // A calibration's rows are the estimate as its rig read it (raw radii: calibrate_diameters
   // measuring one), and take the tree's likewise; the noise part alone models range noise, and

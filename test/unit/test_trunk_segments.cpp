@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "dormant_tree_modeling/common/error.h"
-#include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/radius_calibration.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
@@ -25,14 +24,18 @@ double taper(double z) {
   return 0.05 + (0.015 - 0.05) * z / HEIGHT;
 }
 
+/// 48 points on a horizontal circle at height z.
+void addRing(Points& pts, const Eigen::Vector2d& centre, double radius, double z) {
+  for (int k = 0; k < 48; ++k) {
+    const double phi = 2.0 * M_PI * k / 48;
+    pts.emplace_back(centre.x() + radius * std::cos(phi), centre.y() + radius * std::sin(phi), z);
+  }
+}
+
 Points taperedTrunk() {
   Points pts;
-  for (double z = 0.0; z <= HEIGHT; z += 0.005) {
-    for (int k = 0; k < 48; ++k) {
-      const double phi = 2.0 * M_PI * k / 48;
-      pts.emplace_back(taper(z) * std::cos(phi), taper(z) * std::sin(phi), z);
-    }
-  }
+  for (double z = 0.0; z <= HEIGHT; z += 0.005)
+    addRing(pts, Eigen::Vector2d::Zero(), taper(z), z);
   return pts;
 }
 
@@ -127,13 +130,6 @@ TEST(TrunkSegments, DiameterAlongTheTrunkFollowsTheTaper) {
 constexpr double RODS_FROM_M = 1.6;
 constexpr double ROD_OFFSET_M = 0.05;
 constexpr double ROD_RADIUS_M = 0.01;
-
-void addRing(Points& pts, const Eigen::Vector2d& centre, double radius, double z) {
-  for (int k = 0; k < 48; ++k) {
-    const double phi = 2.0 * M_PI * k / 48;
-    pts.emplace_back(centre.x() + radius * std::cos(phi), centre.y() + radius * std::sin(phi), z);
-  }
-}
 
 Points trunkWithRodsAroundItsTop() {
   Points pts;
