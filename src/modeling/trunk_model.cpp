@@ -55,6 +55,13 @@ struct SliceBounds {
   double max_distance = 1e300;
 };
 
+/// A centreline refined on its slice circles and the slices about it.
+struct SlicedAxis {
+  Centerline line;
+  std::vector<double> s, dist;  ///< each region point's arc length and distance from the line
+  std::vector<Slice> slices;
+};
+
 /// The trunk's track: its axis and the radii it measured along it. A slice continues it: a
 /// trunk tapers to a half or a third of its base radius, and one radius for the whole trunk
 /// lets the thin top's slices take circles around the leader and a scaffold beside it.
@@ -86,6 +93,29 @@ class TrackedAxis {
  private:
   Centerline line_;
   std::vector<std::pair<double, double>> samples_;  // arc length on line_, radius
+};
+
+/// What bounds each slice's circle: its RANSAC band, the trunk-wide bounds, the track's local
+/// radius where there is a track, and the radius each slice should continue (expectedRadii).
+struct SliceLimits {
+  double threshold = 0.0;  ///< RANSAC band (m)
+  SliceBounds bounds;
+  const TrackedAxis* track = nullptr;                    ///< none: the trunk-wide bounds
+  const std::vector<double>* expected_radius = nullptr;  ///< per slice; none: no continuity
+  double continuity = 0.0;  ///< share of the expected radius a RANSAC circle may differ by
+};
+
+/// What fitting the trunk's segments needs: the region sliced along its refined centreline,
+/// the trunk-wide bounds, the cylinders' RANSAC band and the noise their radii are corrected
+/// for (TrunkModel::scatter).
+struct SegmentContext {
+  const Points& pts;
+  const std::vector<int>& region;
+  const SlicedAxis& axis;
+  SliceBounds bounds;
+  double cylinder_threshold = 0.0;
+  double scatter = 0.0;
+  const ModelerConfig& config;
 };
 
 /// Indices of the points within `window` (m) of `centre`.
@@ -144,78 +174,109 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const Circle
 
 namespace {
 
-/// RANSAC circles of every slice along the centreline. With calibrate_at (the range noise), each
-/// slice's corrected radius goes through the trunk calibration; without, it is the radius.
-std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
-                                 const Centerline& line, const std::vector<double>& s,
-                                 const std::vector<double>& dist, double height, double threshold,
-                                 const SliceBounds& bounds, const TrackedAxis& track,
-                                 const std::vector<double>* expected_radius, double continuity,
-                                 std::optional<double> calibrate_at, const ModelerConfig& config) {
-  double lo = 1e300, hi = -1e300;
-  for (const double v : s) {
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
+/// The points of each slice along the centreline within `max_distance` of it; `lo` is the
+/// first slice's start (arc length, m).
+std::vector<std::vector<int>> sliceMembers(const std::vector<int>& region, const SlicedAxis& axis,
+                                           double height, double max_distance, double* lo) {
+  double first = 1e300, last = -1e300;
+  for (const double v : axis.s) {
+    first = std::min(first, v);
+    last = std::max(last, v);
   }
-  lo = std::max(lo, -0.1);
-  hi = std::min(hi, line.length() + 0.1);
-  const int count = std::max(1, static_cast<int>(std::ceil((hi - lo) / height)));
+  first = std::max(first, -0.1);
+  last = std::min(last, axis.line.length() + 0.1);
+  const int count = std::max(1, static_cast<int>(std::ceil((last - first) / height)));
   std::vector<std::vector<int>> members(count);
   for (std::size_t k = 0; k < region.size(); ++k) {
-    const int n = static_cast<int>(std::floor((s[k] - lo) / height));
-    if (n >= 0 && n < count && dist[k] <= bounds.max_distance)
+    const int n = static_cast<int>(std::floor((axis.s[k] - first) / height));
+    if (n >= 0 && n < count && axis.dist[k] <= max_distance)
       members[n].push_back(region[k]);
   }
+  *lo = first;
+  return members;
+}
+
+/// A slice circle's RANSAC options and the radius range its surface mode may take.
+struct SliceCircleOptions {
+  CircleRansacConfig ransac;
+  double min_radius = 0.0, max_radius = 0.0;
+};
+
+/// The options of slice n, centred at `origin`: the trunk-wide bounds, or the track's local
+/// radius where there is a track; RANSAC's radius within `continuity` of the expected radius.
+SliceCircleOptions sliceCircleOptions(const SliceLimits& limits, int n,
+                                      const Eigen::Vector3d& origin, const ModelerConfig& config) {
+  SliceCircleOptions out;
+  CircleRansacConfig& o = out.ransac;
+  o.threshold = limits.threshold;
+  o.iterations = config.fit.ransac_iterations;
+  o.min_radius = limits.bounds.min_radius;
+  o.max_radius = limits.bounds.max_radius;
+  const double local_radius = limits.track ? limits.track->radiusNear(origin) : 0.0;
+  if (local_radius > 0.0) {
+    o.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * local_radius);
+    o.max_radius = std::min(MAX_TRUNK_RADIUS, SLICE_MAX_RADIUS_SHARE * local_radius);
+    o.max_center_offset = SLICE_CENTRE_RADII * local_radius;
+  }
+  out.min_radius = o.min_radius;
+  out.max_radius = o.max_radius;
+  const std::vector<double>* expected = limits.expected_radius;
+  if (expected && (*expected)[n] > 0.0) {
+    o.min_radius = std::max(out.min_radius, (*expected)[n] * (1.0 - limits.continuity));
+    o.max_radius = std::min(out.max_radius, (*expected)[n] * (1.0 + limits.continuity));
+  }
+  o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
+  return out;
+}
+
+/// Slice n's circle from its members. With calibrate_at (the range noise), its corrected
+/// radius goes through the trunk calibration; without, it is the radius.
+void measureSlice(const Points& pts, const std::vector<int>& members, const Centerline& line,
+                  const SliceLimits& limits, int n, std::optional<double> calibrate_at,
+                  const ModelerConfig& config, Slice& sl) {
+  sl.points = static_cast<int>(members.size());
+  if (sl.points < MIN_SLICE_POINTS) {
+    sl.outliers = sl.points;
+    sl.outlier_share = sl.points > 0 ? 1.0 : 0.0;
+    return;
+  }
+  const double mid = sl.s0 + 0.5 * config.trunk.slice_height_m;
+  const Eigen::Vector3d origin = line.pointAt(mid), dir = line.directionAt(mid);
+  const Eigen::Vector3d u = dir.unitOrthogonal(), v = dir.cross(u);
+  Points2 plane;
+  for (const int i : members)
+    plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
+  const SliceCircleOptions o = sliceCircleOptions(limits, n, origin, config);
+  const auto measured =
+      measureSliceCircle(plane, o.ransac, config.noise.correct_bias, o.min_radius, o.max_radius);
+  sl.outliers = sl.points - (measured ? measured->inliers : 0);
+  sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
+  if (!measured || measured->inliers < MIN_SLICE_POINTS / 2)
+    return;
+  sl.has_circle = true;
+  sl.radius = measured->circle.radius;
+  sl.center = origin + measured->circle.center.x() * u + measured->circle.center.y() * v;
+  sl.corrected_radius = sl.radius;
+  // The beam footprint's wings and the noise widen thin sections: the tables take them off.
+  if (measured->surface && calibrate_at) {
+    sl.corrected_radius =
+        config.trunk_calibration.correct(sl.radius, *calibrate_at, MIN_TRUNK_RADIUS);
+  }
+}
+
+/// RANSAC circles of every slice along the axis (trunk.slice_height_m apart).
+std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& region,
+                                 const SlicedAxis& axis, const SliceLimits& limits,
+                                 std::optional<double> calibrate_at, const ModelerConfig& config) {
+  const double height = config.trunk.slice_height_m;
+  double lo = 0.0;
+  const auto members = sliceMembers(region, axis, height, limits.bounds.max_distance, &lo);
+  const int count = static_cast<int>(members.size());
   std::vector<Slice> slices(count);
   // Slices are independent (each RANSAC seeded by its index): all cores, same result.
   parallelFor(count, [&](int n) {
-    Slice& sl = slices[n];
-    sl.s0 = lo + n * height;
-    sl.points = static_cast<int>(members[n].size());
-    if (sl.points < MIN_SLICE_POINTS) {
-      sl.outliers = sl.points;
-      sl.outlier_share = sl.points > 0 ? 1.0 : 0.0;
-      return;
-    }
-    const double mid = sl.s0 + 0.5 * height;
-    const Eigen::Vector3d origin = line.pointAt(mid), dir = line.directionAt(mid);
-    const double local_radius = track.radiusNear(origin);
-    const Eigen::Vector3d u = dir.unitOrthogonal(), v = dir.cross(u);
-    Points2 plane;
-    for (const int i : members[n])
-      plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
-    CircleRansacConfig o;
-    o.threshold = threshold;
-    o.iterations = config.fit.ransac_iterations;
-    o.min_radius = bounds.min_radius;
-    o.max_radius = bounds.max_radius;
-    if (local_radius > 0.0) {
-      o.min_radius = std::max(MIN_TRUNK_RADIUS, SLICE_MIN_RADIUS_SHARE * local_radius);
-      o.max_radius = std::min(MAX_TRUNK_RADIUS, SLICE_MAX_RADIUS_SHARE * local_radius);
-      o.max_center_offset = SLICE_CENTRE_RADII * local_radius;
-    }
-    const double min_radius = o.min_radius, max_radius = o.max_radius;
-    if (expected_radius && (*expected_radius)[n] > 0.0) {
-      o.min_radius = std::max(min_radius, (*expected_radius)[n] * (1.0 - continuity));
-      o.max_radius = std::min(max_radius, (*expected_radius)[n] * (1.0 + continuity));
-    }
-
-    o.seed = config.seed * 7919 + static_cast<std::uint64_t>(n);
-    const auto measured =
-        measureSliceCircle(plane, o, config.noise.correct_bias, min_radius, max_radius);
-    sl.outliers = sl.points - (measured ? measured->inliers : 0);
-    sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
-    if (measured && measured->inliers >= MIN_SLICE_POINTS / 2) {
-      sl.has_circle = true;
-      sl.radius = measured->circle.radius;
-      sl.center = origin + measured->circle.center.x() * u + measured->circle.center.y() * v;
-      sl.corrected_radius = sl.radius;
-      // The beam footprint's wings and the noise widen thin sections: the tables take them off.
-      if (measured->surface && calibrate_at) {
-        sl.corrected_radius =
-            config.trunk_calibration.correct(sl.radius, *calibrate_at, MIN_TRUNK_RADIUS);
-      }
-    }
+    slices[n].s0 = lo + n * height;
+    measureSlice(pts, members[n], axis.line, limits, n, calibrate_at, config, slices[n]);
   });
   return slices;
 }
@@ -309,32 +370,39 @@ Centerline refineCenterline(const std::vector<Slice>& slices, const Centerline& 
   return Centerline(smoothAxis(centres, step));
 }
 
-std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& region,
-                                   const std::vector<double>& s, const std::vector<double>& dist,
-                                   const SliceBounds& bounds, double a, double b,
-                                   const Centerline& line, const std::vector<Slice>& slices,
-                                   double threshold, double sigma, const ModelerConfig& config,
-                                   std::uint64_t stream) {
+/// The region's points of the segment [a, b] (arc length, m) within the trunk's reach.
+Points segmentPoints(const SegmentContext& c, double a, double b) {
   Points sub;
-  for (std::size_t k = 0; k < region.size(); ++k) {
-    if (s[k] >= a && s[k] < b && dist[k] <= bounds.max_distance)
-      sub.push_back(pts[region[k]]);
+  for (std::size_t k = 0; k < c.region.size(); ++k) {
+    if (c.axis.s[k] >= a && c.axis.s[k] < b && c.axis.dist[k] <= c.bounds.max_distance)
+      sub.push_back(c.pts[c.region[k]]);
   }
+  return sub;
+}
+
+/// The RANSAC cylinder of the segment [a, b]: within the trunk-wide bounds, and with
+/// fit.constrain within radius_continuity of its slices' median radius, its axis within 10 deg
+/// of the centreline's chord and within max_tilt_deg of vertical. With noise.correct_bias its
+/// radius is the median of its slices' corrected radii. `stream` seeds its RANSAC.
+std::optional<Cylinder> fitSegment(const SegmentContext& c, double a, double b,
+                                   std::uint64_t stream) {
+  const ModelerConfig& config = c.config;
+  const Points sub = segmentPoints(c, a, b);
   if (sub.size() < static_cast<std::size_t>(MIN_SLICE_POINTS))
     return std::nullopt;
-  Eigen::Vector3d axis = (line.pointAt(b) - line.pointAt(a)).normalized();
+  Eigen::Vector3d axis = (c.axis.line.pointAt(b) - c.axis.line.pointAt(a)).normalized();
   if (!axis.allFinite())
     axis = Eigen::Vector3d::UnitZ();
   CylinderRansacConfig o;
-  o.threshold = threshold;
+  o.threshold = c.cylinder_threshold;
   o.circle_iterations = config.fit.ransac_iterations;
   o.seed = config.seed * 104729 + stream;
-  o.min_radius = bounds.min_radius;
-  o.max_radius = bounds.max_radius;
+  o.min_radius = c.bounds.min_radius;
+  o.max_radius = c.bounds.max_radius;
   o.max_axis_deviation = 35.0 * DEG;
   if (config.fit.constrain) {
     std::vector<double> r;
-    for (const auto& sl : slices) {
+    for (const auto& sl : c.axis.slices) {
       if (sl.has_circle && sl.s0 + 1e-9 >= a - 0.5 * config.trunk.slice_height_m && sl.s0 < b)
         r.push_back(sl.radius);
     }
@@ -359,7 +427,7 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
     // Median over the segment's slices of their noise-corrected radii: slices at branch
     // junctions, whose points include the branch's base, are the minority.
     std::vector<double> r;
-    for (const auto& sl : slices) {
+    for (const auto& sl : c.axis.slices) {
       if (sl.has_circle && sl.s0 + 0.5 * config.trunk.slice_height_m >= a &&
           sl.s0 + 0.5 * config.trunk.slice_height_m < b) {
         r.push_back(sl.corrected_radius);
@@ -369,7 +437,8 @@ std::optional<Cylinder> fitSegment(const Points& pts, const std::vector<int>& re
       Points in;
       for (const int i : inliers)
         in.push_back(sub[i]);
-      cyl->radius = noiseCorrectedRadius(*cyl, in, sigma, threshold, MIN_TRUNK_RADIUS);
+      cyl->radius =
+          noiseCorrectedRadius(*cyl, in, c.scatter, c.cylinder_threshold, MIN_TRUNK_RADIUS);
     } else {
       cyl->radius = std::max(MIN_TRUNK_RADIUS, median(r));
     }
@@ -636,19 +705,18 @@ std::vector<double> joinShortSegments(const std::vector<double>& cuts, double mi
 
 /// Where the share of the segment [a, b)'s points on its cylinder jumps most between bins of
 /// about a slice, if by more than curvature_jump and with min_segment_length on either side.
-std::optional<double> curvatureCut(const Points& pts, const std::vector<int>& region,
-                                   const std::vector<double>& s, const std::vector<double>& dist,
-                                   const SliceBounds& bounds, const Cylinder& cyl, double a,
-                                   double b, double cylinder_threshold,
-                                   const ModelerConfig& config) {
+std::optional<double> curvatureCut(const SegmentContext& c, const Cylinder& cyl, double a,
+                                   double b) {
+  const ModelerConfig& config = c.config;
+  const std::vector<double>& s = c.axis.s;
   const int bins = std::max(2, static_cast<int>((b - a) / config.trunk.slice_height_m));
   std::vector<int> in(bins, 0), all(bins, 0);
-  for (std::size_t k = 0; k < region.size(); ++k) {
-    if (s[k] < a || s[k] >= b || dist[k] > bounds.max_distance)
+  for (std::size_t k = 0; k < c.region.size(); ++k) {
+    if (s[k] < a || s[k] >= b || c.axis.dist[k] > c.bounds.max_distance)
       continue;
     const int bin = std::min(bins - 1, static_cast<int>((s[k] - a) / (b - a) * bins));
     ++all[bin];
-    in[bin] += std::abs(axisDistance(cyl, pts[region[k]]) - cyl.radius) < cylinder_threshold;
+    in[bin] += std::abs(axisDistance(cyl, c.pts[c.region[k]]) - cyl.radius) < c.cylinder_threshold;
   }
   double jump = 0.0;
   int at = -1;
@@ -671,21 +739,14 @@ std::optional<double> curvatureCut(const Points& pts, const std::vector<int>& re
 
 /// Curvature: a segment (at least twice min_segment_length) whose outliers jump along its
 /// cylinder is split at the jump.
-std::vector<double> splitAtCurvature(const Points& pts, const std::vector<int>& region,
-                                     const std::vector<double>& s, const std::vector<double>& dist,
-                                     const SliceBounds& bounds, const Centerline& line,
-                                     const std::vector<Slice>& slices,
-                                     const std::vector<double>& cuts, double cylinder_threshold,
-                                     double scatter, const ModelerConfig& config) {
+std::vector<double> splitAtCurvature(const SegmentContext& c, const std::vector<double>& cuts) {
   std::vector<double> out{cuts.front()};
   std::uint64_t stream = 0;
   for (std::size_t i = 1; i < cuts.size(); ++i) {
     const double a = out.back(), b = cuts[i];
-    if (b - a >= 2.0 * config.trunk.min_segment_length_m) {
-      if (const auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, line, slices,
-                                      cylinder_threshold, scatter, config, stream++)) {
-        if (const auto cut =
-                curvatureCut(pts, region, s, dist, bounds, *cyl, a, b, cylinder_threshold, config))
+    if (b - a >= 2.0 * c.config.trunk.min_segment_length_m) {
+      if (const auto cyl = fitSegment(c, a, b, stream++)) {
+        if (const auto cut = curvatureCut(c, *cyl, a, b))
           out.push_back(*cut);
       }
     }
@@ -760,11 +821,9 @@ double trunkNoise(const Points& pts, const std::vector<int>& region, const Cente
 
 /// The segment boundaries along the centreline: disturbance partitions, short ones joined,
 /// split at curvature, at bends (trunk.max_bend_m) and where too long.
-std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
-                              const std::vector<double>& s, const std::vector<double>& dist,
-                              const SliceBounds& bounds, const Centerline& line,
-                              const std::vector<Slice>& slices, double cylinder_threshold,
-                              double scatter, const ModelerConfig& config) {
+std::vector<double> trunkCuts(const SegmentContext& c) {
+  const ModelerConfig& config = c.config;
+  const std::vector<Slice>& slices = c.axis.slices;
   const double h = config.trunk.slice_height_m;
   double top = 0.0;
   for (const auto& sl : slices) {
@@ -774,12 +833,11 @@ std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
   const auto joined =
       joinShortSegments(disturbancePartitions(slices, h, config.trunk.disturbance_zero_run, top),
                         config.trunk.min_segment_length_m);
-  std::vector<double> cuts = splitAtCurvature(pts, region, s, dist, bounds, line, slices, joined,
-                                              cylinder_threshold, scatter, config);
+  std::vector<double> cuts = splitAtCurvature(c, joined);
   if (config.trunk.max_bend_m > 0.0) {
     std::vector<double> straight{cuts.front()};
     for (std::size_t i = 1; i < cuts.size(); ++i) {
-      splitAtBends(line, straight.back(), cuts[i], h, config.trunk.max_bend_m,
+      splitAtBends(c.axis.line, straight.back(), cuts[i], h, config.trunk.max_bend_m,
                    config.trunk.min_segment_length_m, straight);
       straight.push_back(cuts[i]);
     }
@@ -793,20 +851,16 @@ std::vector<double> trunkCuts(const Points& pts, const std::vector<int>& region,
 /// One cylinder per segment; with graph.follow_diameter a segment no RANSAC cylinder fits (a
 /// whorl of branches, a bend) takes the centreline's chord and the slices' median radius,
 /// rather than leaving a gap in the trunk that would orphan the branches on it.
-void fitCylinders(const Points& pts, const std::vector<int>& region, const std::vector<double>& s,
-                  const std::vector<double>& dist, const SliceBounds& bounds,
-                  double cylinder_threshold, double scatter, const ModelerConfig& config,
-                  TrunkModel& trunk) {
+void fitCylinders(const SegmentContext& c, TrunkModel& trunk) {
   const std::vector<double>& cuts = trunk.partitions;
   for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
     const double a = cuts[i], b = cuts[i + 1];
-    if (auto cyl = fitSegment(pts, region, s, dist, bounds, a, b, trunk.centerline, trunk.slices,
-                              cylinder_threshold, scatter, config, SEGMENT_SEED_BASE + i)) {
+    if (auto cyl = fitSegment(c, a, b, SEGMENT_SEED_BASE + i)) {
       trunk.cylinders.push_back(*cyl);
       trunk.cylinder_ranges.emplace_back(a, b);
-    } else if (config.graph.follow_diameter) {
-      if (auto chord = segmentFromSlices(trunk.slices, trunk.centerline, a, b,
-                                         config.trunk.slice_height_m)) {
+    } else if (c.config.graph.follow_diameter) {
+      if (auto chord =
+              segmentFromSlices(c.axis.slices, c.axis.line, a, b, c.config.trunk.slice_height_m)) {
         trunk.cylinders.push_back(*chord);
         trunk.cylinder_ranges.emplace_back(a, b);
       }
@@ -827,13 +881,6 @@ void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
   }
 }
 
-/// A centreline refined on its slice circles and the slices about it.
-struct SlicedAxis {
-  Centerline line;
-  std::vector<double> s, dist;  ///< each region point's arc length and distance from the line
-  std::vector<Slice> slices;
-};
-
 /// Slices on the initial axis, then CENTERLINE_ROUNDS rounds of refining the centreline on
 /// their circles and slicing again.
 SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
@@ -849,8 +896,8 @@ SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
                                   std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
     projectRegion(pts, region, out.line, out.s, out.dist);
     out.slices =
-        computeSlices(pts, region, out.line, out.s, out.dist, h, config.fit.circle_threshold_m,
-                      bounds, track, nullptr, 0.0, std::nullopt, config);
+        computeSlices(pts, region, out, SliceLimits{config.fit.circle_threshold_m, bounds, &track},
+                      std::nullopt, config);
   }
   return out;
 }
@@ -878,10 +925,6 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   const double sigma = trunkNoise(pts, region, sliced.line, sliced.slices, config, &slice_radii);
   if (!track.empty())
     sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
-  Centerline& line = sliced.line;
-  std::vector<double>& s = sliced.s;
-  std::vector<double>& dist = sliced.dist;
-  std::vector<Slice>& slices = sliced.slices;
   trunk.noise_sigma = sigma;
   // A calibration's rows are the estimate as its rig read it (raw radii: calibrate_diameters
   // measuring one), and take the tree's likewise; the noise part alone models range noise, and
@@ -900,16 +943,17 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     cylinder_threshold = std::max(cylinder_threshold, noiseBand(sigma));
   }
   if (config.fit.constrain || config.noise.derive_parameters || config.noise.correct_bias) {
-    const auto expected = expectedRadii(slices);
-    slices = computeSlices(pts, region, line, s, dist, h, circle_threshold, bounds, track,
-                           config.fit.constrain ? &expected : nullptr,
-                           config.trunk.radius_continuity, trunk.table_sigma, config);
+    const auto expected = expectedRadii(sliced.slices);
+    const SliceLimits limits{circle_threshold, bounds, &track,
+                             config.fit.constrain ? &expected : nullptr,
+                             config.trunk.radius_continuity};
+    sliced.slices = computeSlices(pts, region, sliced, limits, trunk.table_sigma, config);
   }
-  trunk.slices = slices;
-  trunk.centerline = line;
-  trunk.partitions =
-      trunkCuts(pts, region, s, dist, bounds, line, slices, cylinder_threshold, scatter, config);
-  fitCylinders(pts, region, s, dist, bounds, cylinder_threshold, scatter, config, trunk);
+  trunk.slices = sliced.slices;
+  trunk.centerline = sliced.line;
+  const SegmentContext segments{pts, region, sliced, bounds, cylinder_threshold, scatter, config};
+  trunk.partitions = trunkCuts(segments);
+  fitCylinders(segments, trunk);
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
   if (config.noise.correct_bias && config.trunk.taper_profile)
