@@ -23,8 +23,13 @@ namespace modeling {
 
 namespace {
 
-constexpr double GROUND_BAND = 0.03;          // m above the ground plane removed with it
-constexpr double GROUND_MIN_EXTENT = 0.8;     // m: a plane smaller than this is not the ground
+constexpr double GROUND_BAND = 0.03;  // m above the ground plane removed with it
+// A plane is the ground when its returns reach at least GROUND_MIN_LENGTH along their longer
+// horizontal direction (more than a trunk base is wide: the trunk step allows 0.4 m of radius)
+// and GROUND_MIN_WIDTH across it (more than a wire or a branch lying low). A tree's crop
+// across the row can hold a strip of ground narrower than its length.
+constexpr double GROUND_MIN_LENGTH = 0.8;     // m
+constexpr double GROUND_MIN_WIDTH = 0.3;      // m
 constexpr std::size_t GROUND_SAMPLE = 50000;  // low points that score a ground hypothesis
 constexpr double SPACING_CELL = 0.02;         // m, grid of medianSpacing() without an index
 // Above max_modeled_points the grid grows by at least this factor per round, from at least
@@ -76,6 +81,27 @@ std::size_t capPoints(Points& pts, std::size_t cap, double* voxel) {
   return before - pts.size();
 }
 
+/// The extents (m) of points' horizontal positions along their two principal directions,
+/// longer first.
+Eigen::Vector2d horizontalExtents(const Points& pts, const std::vector<int>& idx) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const int i : idx)
+    mean += pts[i].head<2>();
+  mean /= static_cast<double>(idx.size());
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const int i : idx)
+    cov += (pts[i].head<2>() - mean) * (pts[i].head<2>() - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
+  for (const int i : idx) {
+    const Eigen::Vector2d q = eig.eigenvectors().transpose() * (pts[i].head<2>() - mean);
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  const Eigen::Vector2d e = hi - lo;
+  return Eigen::Vector2d(e.maxCoeff(), e.minCoeff());
+}
+
 /// Removes points near a near-horizontal plane at the bottom of the cloud, if it is large.
 std::size_t removeGround(Points& pts, std::uint64_t seed) {
   if (pts.size() < 100)
@@ -123,15 +149,16 @@ std::size_t removeGround(Points& pts, std::uint64_t seed) {
       best_d = d;
     }
   }
-  // The plane must be wide in both horizontal directions: a trunk base is not the ground.
-  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  // The plane must be long and wide: a trunk base, a wire or a low branch is not the ground.
+  std::vector<int> on;
   for (const int i : low) {
-    if (std::abs(best_n.dot(pts[i]) + best_d) < 0.02) {
-      lo = lo.cwiseMin(pts[i].head<2>());
-      hi = hi.cwiseMax(pts[i].head<2>());
-    }
+    if (std::abs(best_n.dot(pts[i]) + best_d) < 0.02)
+      on.push_back(i);
   }
-  if (best_count * stride < 100 || (hi - lo).minCoeff() < GROUND_MIN_EXTENT)
+  if (best_count * stride < 100 || on.empty())
+    return 0;
+  const Eigen::Vector2d extents = horizontalExtents(pts, on);
+  if (extents[0] < GROUND_MIN_LENGTH || extents[1] < GROUND_MIN_WIDTH)
     return 0;
   const std::size_t before = pts.size();
   pts.erase(std::remove_if(

@@ -195,6 +195,61 @@ TEST(NeighbourGrowthDimension, LinesSurfacesAndVolumesReadOneTwoAndThree) {
   EXPECT_EQ(dimension(lonely), 0.0) << "no neighbours: no dimension";
 }
 
+/// A 5 cm trunk standing on z = 0, 1.5 m tall.
+Points standingTrunk(Rng& rng) {
+  Points pts;
+  for (int i = 0; i < 20000; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI);
+    pts.push_back(Eigen::Vector3d(0.025 * std::cos(a), 0.025 * std::sin(a), rng.uniform(0.0, 1.5)));
+  }
+  return pts;
+}
+
+/// Points within `radius` of the z axis, above `z`.
+std::size_t countNearAxis(const Points& cloud, double radius, double z) {
+  return std::count_if(cloud.begin(), cloud.end(), [&](const Eigen::Vector3d& p) {
+    return std::hypot(p.x(), p.y()) < radius && p.z() > z;
+  });
+}
+
+TEST(Preprocess, TakesANarrowStripOfGroundButNeitherATrunkBaseNorALowWire) {
+  // A tree's crop across the row can hold a strip of ground narrower than it is long: 1.6 x
+  // 0.5 m here, under the trunk. It goes and the trunk stays; the trunk alone, or with a
+  // wire lying 5 cm above its foot, has no ground.
+  ModelerConfig config;
+  config.preprocess.remove_clutter = true;
+  Rng rng(21);
+  const Points trunk = standingTrunk(rng);
+  Points strip;
+  for (int i = 0; i < 6000; ++i) {
+    strip.push_back(
+        Eigen::Vector3d(rng.uniform(-0.8, 0.8), rng.uniform(-0.25, 0.25), rng.normal(0.0, 0.005)));
+  }
+  Points scene = trunk;
+  scene.insert(scene.end(), strip.begin(), strip.end());
+  PreprocessStats stats;
+  const Points out = preprocess(scene, config, &stats);
+  EXPECT_GT(stats.ground, 0u);
+  const auto onGround = std::count_if(out.begin(), out.end(), [](const Eigen::Vector3d& p) {
+    return p.z() < 0.02 && std::hypot(p.x(), p.y()) > 0.05;
+  });
+  EXPECT_EQ(onGround, 0) << "ground left beside the trunk";
+  const Points trunk_voxels = voxelDownsample(trunk, config.preprocess.voxel_size_m);
+  EXPECT_GT(countNearAxis(out, 0.05, 0.05), 0.95 * countNearAxis(trunk_voxels, 0.05, 0.05));
+
+  PreprocessStats alone;
+  preprocess(trunk, config, &alone);
+  EXPECT_EQ(alone.ground, 0u) << "a trunk's base is no ground";
+  Points wired = trunk;
+  for (int i = 0; i < 3000; ++i) {
+    wired.push_back(Eigen::Vector3d(rng.uniform(-0.8, 0.8), 0.1 + rng.normal(0.0, 0.003),
+                                    0.05 + rng.normal(0.0, 0.003)));
+  }
+  PreprocessStats with_wire;
+  preprocess(wired, config, &with_wire);
+  EXPECT_EQ(with_wire.ground, 0u) << "a low wire is no ground";
+}
+
 TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
   // A trunk, and a noisy 2 m wire beside it, not quite along x: the wire goes, its direction
   // is reported (the modeler takes short wire pieces as parallel to it), the trunk stays.
