@@ -14,6 +14,7 @@
 #include "dormant_tree_modeling/common/parallel.h"
 #include "dormant_tree_modeling/common/random.h"
 #include "dormant_tree_modeling/common/statistics.h"
+#include "dormant_tree_modeling/modeling/geometry_fit.h"
 #include "dormant_tree_modeling/modeling/point_index.h"
 
 #include "cell_grid.h"
@@ -81,20 +82,17 @@ std::size_t capPoints(Points& pts, std::size_t cap, double* voxel) {
   return before - pts.size();
 }
 
-/// The extents (m) of points' horizontal positions along their two principal directions,
-/// longer first.
+/// The extents (m) of points' horizontal positions along their principal direction and across
+/// it, longer first.
 Eigen::Vector2d horizontalExtents(const Points& pts, const std::vector<int>& idx) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Points flat;
   for (const int i : idx)
-    mean += pts[i].head<2>();
-  mean /= static_cast<double>(idx.size());
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const int i : idx)
-    cov += (pts[i].head<2>() - mean) * (pts[i].head<2>() - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    flat.emplace_back(pts[i].x(), pts[i].y(), 0.0);
+  const Eigen::Vector3d along = principalAxis(flat);
+  const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(along);
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
-  for (const int i : idx) {
-    const Eigen::Vector2d q = eig.eigenvectors().transpose() * (pts[i].head<2>() - mean);
+  for (const auto& p : flat) {
+    const Eigen::Vector2d q(p.dot(along), p.dot(across));
     lo = lo.cwiseMin(q);
     hi = hi.cwiseMax(q);
   }

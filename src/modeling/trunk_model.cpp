@@ -370,11 +370,16 @@ Centerline refineCenterline(const std::vector<Slice>& slices, const Centerline& 
   return Centerline(smoothAxis(centres, step));
 }
 
-/// The region's points of the segment [a, b] (arc length, m) within the trunk's reach.
+/// Whether region point k lies in the segment [a, b) (arc length, m) within the trunk's reach.
+bool inSegment(const SegmentContext& c, std::size_t k, double a, double b) {
+  return c.axis.s[k] >= a && c.axis.s[k] < b && c.axis.dist[k] <= c.bounds.max_distance;
+}
+
+/// The region's points of the segment [a, b).
 Points segmentPoints(const SegmentContext& c, double a, double b) {
   Points sub;
   for (std::size_t k = 0; k < c.region.size(); ++k) {
-    if (c.axis.s[k] >= a && c.axis.s[k] < b && c.axis.dist[k] <= c.bounds.max_distance)
+    if (inSegment(c, k, a, b))
       sub.push_back(c.pts[c.region[k]]);
   }
   return sub;
@@ -712,7 +717,7 @@ std::optional<double> curvatureCut(const SegmentContext& c, const Cylinder& cyl,
   const int bins = std::max(2, static_cast<int>((b - a) / config.trunk.slice_height_m));
   std::vector<int> in(bins, 0), all(bins, 0);
   for (std::size_t k = 0; k < c.region.size(); ++k) {
-    if (s[k] < a || s[k] >= b || c.axis.dist[k] > c.bounds.max_distance)
+    if (!inSegment(c, k, a, b))
       continue;
     const int bin = std::min(bins - 1, static_cast<int>((s[k] - a) / (b - a) * bins));
     ++all[bin];
