@@ -103,10 +103,10 @@ void recentre(RigScan& scan) {
     v.in_station = Eigen::Translation3d(-origin) * v.in_station;
 }
 
-/// Every rod the whole modeler finds near its stated axis, its raw radius; sets the scan's
-/// noise estimate.
+/// Every rod the whole modeler finds near its stated axis, its raw radius, keyed on the scan's
+/// standard noise reading `sigma`.
 std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerConfig& raw,
-                                   const RigSearch& search, double* sigma,
+                                   const RigSearch& search, double sigma,
                                    std::vector<std::string>* warnings) {
   modeling::ModelResult result;
   try {
@@ -115,7 +115,6 @@ std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerC
     throw Error(e.code() == ErrorCode::EMPTY_INPUT ? ErrorCode::EMPTY_INPUT : ErrorCode::NO_TRUNK,
                 "rig scan " + scan.name + ": " + e.what());
   }
-  *sigma = result.noise_sigma;
   evaluation::MatchBounds bounds;
   bounds.min_distance = search.axis_tolerance_m;
   bounds.max_arc_length = MAX_ROD_ARC_M;
@@ -128,7 +127,7 @@ std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerC
     s.index = scan.rig.primary_branches[m.truth].id;
     s.radius = 0.5 * scan.rig.primary_branches[m.truth].diameters.front();
     s.apparent = 0.5 * m.detected_diameter;
-    s.noise = *sigma;
+    s.noise = sigma;
     out.push_back(s);
   }
   for (const int t : score.missed) {
@@ -140,9 +139,10 @@ std::vector<RigSample> measureRods(const RigScan& scan, const modeling::ModelerC
   return out;
 }
 
-/// Every pipe section's raw radius: the median of the trunk step's slice circles along it.
+/// Every pipe section's raw radius (the median of the trunk step's slice circles along it) and
+/// the noise the trunk step estimated on it, in `reading`.
 std::vector<RigSample> measureSections(const RigScan& scan, const modeling::ModelerConfig& raw,
-                                       const RigSearch& search, double sigma,
+                                       const RigSearch& search, modeling::NoiseReading* reading,
                                        std::vector<std::string>* warnings) {
   std::vector<RigSample> out;
   for (const Section& sec : pipeSections(scan.rig.trunk, search, raw.trunk.slice_height_m)) {
@@ -156,8 +156,10 @@ std::vector<RigSample> measureSections(const RigScan& scan, const modeling::Mode
         region.push_back(static_cast<int>(i));
     }
     std::vector<double> radii;
+    double noise = 0.0;
     try {
       const auto trunk = modeling::modelTrunk(scan.points, region, {sec.a, sec.b}, sec.radius, raw);
+      noise = trunk.noise_sigma;
       for (const auto& sl : trunk.slices) {
         const double t = (sl.center - sec.a).dot(d);
         if (sl.has_circle && t >= 0.0 && t <= len)
@@ -179,10 +181,46 @@ std::vector<RigSample> measureSections(const RigScan& scan, const modeling::Mode
     s.index = sec.index;
     s.radius = sec.radius;
     s.apparent = median(radii);
-    s.noise = sigma;
     out.push_back(s);
+    if (noise > 0.0) {
+      reading->radii_m.push_back(sec.radius);
+      reading->noise_m.push_back(noise);
+    }
   }
   return out;
+}
+
+/// The scan's reading at STANDARD_READING_RADIUS_M, which keys its rows; its sections' readings
+/// sorted by radius (equal radii averaged).
+double standardReading(const RigScan& scan, modeling::NoiseReading* reading,
+                       std::vector<std::string>* warnings) {
+  std::map<double, std::pair<double, int>> by_radius;
+  for (std::size_t i = 0; i < reading->radii_m.size(); ++i) {
+    auto& e = by_radius[reading->radii_m[i]];
+    e.first += reading->noise_m[i];
+    ++e.second;
+  }
+  if (by_radius.empty()) {
+    throw Error(ErrorCode::NO_TRUNK,
+                "rig scan " + scan.name +
+                    ": no pipe section measured, so the scanner's noise cannot be read on it: "
+                    "check the rig file's pipe axis against the scan's frame");
+  }
+  *reading = {};
+  for (const auto& [radius, e] : by_radius) {
+    reading->radii_m.push_back(radius);
+    reading->noise_m.push_back(e.first / e.second);
+  }
+  const double lo = reading->radii_m.front(), hi = reading->radii_m.back();
+  const double r = modeling::STANDARD_READING_RADIUS_M;
+  if (r < lo * (1.0 - modeling::COVERAGE_RADIUS_SLACK) ||
+      r > hi * (1.0 + modeling::COVERAGE_RADIUS_SLACK)) {
+    warnings->push_back("rig scan " + scan.name + ": its pipe sections measured (" + mm(2 * lo) +
+                        " to " + mm(2 * hi) + " diameter) do not reach " + mm(2 * r) +
+                        ", where the noise rows are read: the nearest section's reading is "
+                        "taken; add a section of that diameter");
+  }
+  return reading->at(r);
 }
 
 /// Pool-adjacent-violators: the least-squares non-increasing sequence.
@@ -607,13 +645,17 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
                       "rods ('primary_branches')");
     }
     recentre(scan);
-    double sigma = 0.0;
-    auto rods = measureRods(scan, raw, search, &sigma, &result.warnings);
-    auto sections = measureSections(scan, raw, search, sigma, &result.warnings);
+    modeling::NoiseReading reading;
+    auto sections = measureSections(scan, raw, search, &reading, &result.warnings);
+    const double sigma = standardReading(scan, &reading, &result.warnings);
+    auto rods = measureRods(scan, raw, search, sigma, &result.warnings);
     for (auto& s : rods)
       s.noise_part = branch_noise.biasAt(s.radius, sigma);
-    for (auto& s : sections)
+    for (auto& s : sections) {
+      s.noise = sigma;
       s.noise_part = trunk_noise.biasAt(s.radius, sigma);
+    }
+    result.calibration.noise_readings.push_back(reading);
     result.samples.insert(result.samples.end(), sections.begin(), sections.end());
     result.samples.insert(result.samples.end(), rods.begin(), rods.end());
     sigmas.push_back(sigma);

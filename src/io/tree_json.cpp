@@ -188,6 +188,7 @@ json correctionJson(const modeling::DiameterCorrection& c) {
       {"calibration_hash", c.calibration_hash.empty() ? json(nullptr) : json(c.calibration_hash)},
       {"noise_sigma_m", c.noise_sigma},
       {"table_noise_sigma_m", c.table_noise_sigma},
+      {"search_noise_sigma_m", c.search_noise_sigma},
       {"warnings", c.warnings}};
 }
 
@@ -205,6 +206,8 @@ modeling::DiameterCorrection correctionFromJson(const json& doc) {
     c.noise_sigma = j["noise_sigma_m"].get<double>();
   if (j.contains("table_noise_sigma_m") && j["table_noise_sigma_m"].is_number())
     c.table_noise_sigma = j["table_noise_sigma_m"].get<double>();
+  if (j.contains("search_noise_sigma_m") && j["search_noise_sigma_m"].is_number())
+    c.search_noise_sigma = j["search_noise_sigma_m"].get<double>();
   if (j.contains("warnings") && j["warnings"].is_array()) {
     for (const auto& w : j["warnings"]) {
       if (w.is_string())

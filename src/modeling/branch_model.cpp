@@ -60,6 +60,7 @@ BranchBands branchBands(const TrunkModel& trunk, const ModelerConfig& config) {
   BranchBands b;
   b.sigma = trunk.noise_sigma;
   b.table_sigma = trunk.table_sigma;
+  b.search_sigma = trunk.search_sigma;
   b.scatter = config.noise.correct_bias ? trunk.scatter : 0.0;
   b.threshold = config.fit.cylinder_threshold_m;
   if (config.noise.derive_parameters)

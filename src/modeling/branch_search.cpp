@@ -254,7 +254,8 @@ void BranchSearch::examine(const Candidate& candidate) {
       return reject(candidate, near.segment, *verdict);
   }
   if (config.preprocess.remove_clutter &&
-      looksLikeWire(*cyl, seg, context_.index, context_.bands.sigma, context_.wire_directions)) {
+      looksLikeWire(*cyl, seg, context_.index, context_.bands.search_sigma,
+                    context_.wire_directions)) {
     // A wire passing close to a branch joins its cluster: the wire's points go, the rest is
     // looked at again.
     const std::vector<int> wire = searchRest(candidate.members, *cyl);
@@ -332,7 +333,7 @@ BranchSearch::NearPart BranchSearch::alongLine(const NearPart& near, const Cylin
 /// the noise band and a margin.
 double BranchSearch::extractionReach(const Cylinder& found) const {
   const BranchBands& bands = context_.bands;
-  return found.radius + noiseBand(std::max(bands.sigma, bands.scatter)) + EXTRACTION_MARGIN;
+  return found.radius + noiseBand(std::max(bands.search_sigma, bands.scatter)) + EXTRACTION_MARGIN;
 }
 
 std::uint64_t BranchSearch::nextFitSeed() {
@@ -551,7 +552,7 @@ void BranchSearch::reject(const Candidate& candidate, int segment, Verdict verdi
 bool BranchSearch::splitAlongRay(const Candidate& candidate, const Points& cluster_pts,
                                  int segment) {
   const ModelerConfig& config = context_.config;
-  const double sigma = context_.bands.sigma;
+  const double sigma = context_.bands.search_sigma;
   if (!config.branches.ray_split || sigma < config.branches.ray_split_min_noise_m || candidate.ray)
     return false;
   const auto ray =

@@ -25,11 +25,12 @@ struct TrunkCoords {
 
 /// The noise bands of one tree's branch search, derived once from the trunk's noise estimate.
 struct BranchBands {
-  double sigma = 0.0;        ///< range noise, m
-  double table_sigma = 0.0;  ///< the noise as the radius tables read it, m (TrunkModel)
-  double scatter = 0.0;      ///< the beam's lateral scatter taken off radii, m (0: none)
-  double threshold = 0.0;    ///< cylinder inlier band, m
-  double inner_gap = 0.0;    ///< how far off the trunk surface candidates start, m
+  double sigma = 0.0;         ///< range noise, m
+  double search_sigma = 0.0;  ///< the scatter the search's gates take, m (TrunkModel)
+  double table_sigma = 0.0;   ///< the noise as the radius tables read it, m (TrunkModel)
+  double scatter = 0.0;       ///< the beam's lateral scatter taken off radii, m (0: none)
+  double threshold = 0.0;     ///< cylinder inlier band, m
+  double inner_gap = 0.0;     ///< how far off the trunk surface candidates start, m
 };
 
 /// The candidate points of the branch search and where each sits on the trunk.

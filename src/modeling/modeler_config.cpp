@@ -170,7 +170,8 @@ void addBranchSearch(ConfigTable<ModelerConfig>& t) {
            "A fused candidate is first parted along its strongest ray from the trunk axis.")
       .formerly("branch_ray_split")
       .add("branches.ray_split_min_noise_m", &B::ray_split_min_noise_m, 0.0, 1.0,
-           "... from this estimated noise on (below it a whorl's branches stay apart).")
+           "... from this scatter about every trunk slice on (search_noise_sigma_m; below it "
+           "a whorl's branches stay apart).")
       .formerly("branch_ray_split_min_noise")
       .add("branches.keep_cut_off", &B::keep_cut_off,
            "A fit cut off from the trunk by a crossing branch's extraction is kept when returns "

@@ -41,9 +41,6 @@ const double ROD_ELEVATIONS_RAD[] = {0.0, 20.0 * M_PI / 180.0, 40.0 * M_PI / 180
 // branch's by the trunk radius where it leaves: primaries are 0.3..0.6 of it.
 constexpr double TRUNK_TO_BRANCH = 2.5;
 constexpr double MIN_BRANCH_BOUND_M = 0.025;
-// The tables' noise axis is what the estimator reads on slices of this radius (the standard
-// reading); on a thinner trunk it reads less for the same noise (standardNoiseReading).
-constexpr double ESTIMATOR_RADIUS_M = 0.05;
 // Slice radii the estimator's reading is modelled at are rounded to this (m).
 constexpr double READING_RADIUS_STEP_M = 0.001;
 constexpr double MIN_AXIS_STEP_M = 1e-5;
@@ -189,7 +186,7 @@ RadiusCalibration tabulate(const ModelerConfig& config, const std::vector<double
                            std::uint64_t seed, Bias bias) {
   RadiusCalibration t;
   t.radii = radii;
-  t.noise = estimatedNoiseAxis(config, {ESTIMATOR_RADIUS_M}, seed);
+  t.noise = estimatedNoiseAxis(config, {STANDARD_READING_RADIUS_M}, seed);
   t.bias.assign(radii.size() * NOISE_M.size(), 0.0);
   const int cells = static_cast<int>(t.bias.size());
   parallelFor(cells, [&](int i) {
@@ -227,26 +224,16 @@ std::vector<double> readingAxis(const ModelerConfig& config,
       key, [&] { return estimatedNoiseAxis(config, radii, config.seed * READING_SEED); });
 }
 
-/// Piecewise-linear map of v from the ascending axis `from` onto `to` (same length); beyond
-/// the ends in proportion to the end value.
-double mapAlong(const std::vector<double>& from, const std::vector<double>& to, double v) {
-  if (v <= from.front())
-    return v * to.front() / from.front();
-  if (v >= from.back())
-    return v * to.back() / from.back();
-  const std::size_t k = std::upper_bound(from.begin(), from.end(), v) - from.begin();
-  const double t = (v - from[k - 1]) / (from[k] - from[k - 1]);
-  return to[k - 1] + t * (to[k] - to[k - 1]);
-}
-
 }  // namespace
 
 double standardNoiseReading(const ModelerConfig& config, double sigma,
                             const std::vector<double>& slice_radii) {
   if (!(sigma > 0.0) || slice_radii.empty())
     return sigma;
-  return mapAlong(readingAxis(config, slice_radii), readingAxis(config, {ESTIMATOR_RADIUS_M}),
-                  sigma);
+  if (config.calibration.given())
+    return config.calibration.standardReading(sigma, slice_radii);
+  return mapAlong(readingAxis(config, slice_radii),
+                  readingAxis(config, {STANDARD_READING_RADIUS_M}), sigma);
 }
 
 RadiusCalibration trunkNoiseBias(const ModelerConfig& config) {

@@ -76,5 +76,15 @@ double RadiusCalibration::correct(double apparent, double sigma, double min_radi
   return 0.5 * (lo + hi);
 }
 
+double mapAlong(const std::vector<double>& from, const std::vector<double>& to, double v) {
+  if (v <= from.front())
+    return v * to.front() / from.front();
+  if (v >= from.back())
+    return v * to.back() / from.back();
+  const std::size_t k = std::upper_bound(from.begin(), from.end(), v) - from.begin();
+  const double t = (v - from[k - 1]) / (from[k] - from[k - 1]);
+  return to[k - 1] + t * (to[k] - to[k - 1]);
+}
+
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

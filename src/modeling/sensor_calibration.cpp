@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -73,6 +74,37 @@ RadiusCalibration readTable(const YAML::Node& root, const std::string& key,
   return t;
 }
 
+/// The rig scans' noise readings: a list of {radii_m, noise_m}, none when absent.
+std::vector<NoiseReading> readNoiseReadings(const YAML::Node& root, const std::string& path) {
+  std::vector<NoiseReading> out;
+  const YAML::Node list = root["noise_readings"];
+  if (!list)
+    return out;
+  if (!list.IsSequence())
+    fail(ErrorCode::PARSE_ERROR, path, "'noise_readings' is not a list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = "noise_readings[" + std::to_string(i) + "]";
+    if (!list[i].IsMap())
+      fail(ErrorCode::PARSE_ERROR, path, "'" + where + "' is not a map");
+    for (const auto& kv : list[i]) {
+      const std::string k = kv.first.as<std::string>();
+      if (k != "radii_m" && k != "noise_m")
+        fail(ErrorCode::PARSE_ERROR, path, "unknown key '" + where + "." + k + "'");
+    }
+    NoiseReading r{numbers(list[i], "radii_m", where, path),
+                   numbers(list[i], "noise_m", where, path)};
+    const bool noise_ok = std::all_of(r.noise_m.begin(), r.noise_m.end(),
+                                      [](double v) { return v > 0.0 && v <= MAX_NOISE_M; });
+    if (r.radii_m.empty() || r.radii_m.size() != r.noise_m.size() ||
+        !strictlyAscending(r.radii_m) || !(r.radii_m.front() > 0.0) ||
+        !(r.radii_m.back() <= MAX_RADIUS_M) || !noise_ok)
+      fail(ErrorCode::INVALID_ARGUMENT, path,
+           where + ": radii_m ascending in (0, 1] m and as many noise_m in (0, 0.1] m");
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 std::pair<double, double> range(const YAML::Node& n, const std::string& key,
                                 const std::string& path) {
   const auto v = numbers(n, key, "covers", path);
@@ -134,9 +166,10 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   }
   if (!doc.IsMap() || !doc[ROOT_KEY])
     fail(ErrorCode::PARSE_ERROR, path, std::string("no top-level '") + ROOT_KEY + "' map");
-  const YAML::Node root = section(
-      doc, ROOT_KEY,
-      {"name", "sources", "covers", "trunk_footprint", "branch_footprint", "silhouette"}, path);
+  const YAML::Node root = section(doc, ROOT_KEY,
+                                  {"name", "sources", "covers", "noise_readings", "trunk_footprint",
+                                   "branch_footprint", "silhouette"},
+                                  path);
   SensorCalibration c;
   try {
     c.name = root["name"].as<std::string>();
@@ -156,6 +189,7 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   std::tie(c.coverage.branch_radius_min_m, c.coverage.branch_radius_max_m) =
       range(covers, "branch_radius_m", path);
   std::tie(c.coverage.noise_min_m, c.coverage.noise_max_m) = range(covers, "noise_m", path);
+  c.noise_readings = readNoiseReadings(root, path);
   if (root["silhouette"]) {
     const YAML::Node s =
         section(root, "silhouette",
@@ -185,6 +219,39 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
   return c;
 }
 
+double NoiseReading::at(double radius) const {
+  if (radii_m.empty())
+    return 0.0;
+  if (radius <= radii_m.front())
+    return noise_m.front();
+  if (radius >= radii_m.back())
+    return noise_m.back();
+  const std::size_t k = std::upper_bound(radii_m.begin(), radii_m.end(), radius) - radii_m.begin();
+  const double t = (radius - radii_m[k - 1]) / (radii_m[k] - radii_m[k - 1]);
+  return noise_m[k - 1] + t * (noise_m[k] - noise_m[k - 1]);
+}
+
+double SensorCalibration::standardReading(double sigma,
+                                          const std::vector<double>& slice_radii) const {
+  if (noise_readings.empty() || slice_radii.empty())
+    return sigma;
+  // Per rig scan: its reading on the tree's slices (their mean) and its standard reading.
+  std::vector<std::pair<double, double>> pairs;
+  for (const NoiseReading& r : noise_readings) {
+    double sum = 0.0;
+    for (const double x : slice_radii)
+      sum += r.at(x);
+    pairs.emplace_back(sum / slice_radii.size(), r.at(STANDARD_READING_RADIUS_M));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<double> on_slices, standard;
+  for (const auto& [a, b] : pairs) {
+    on_slices.push_back(a);
+    standard.push_back(b);
+  }
+  return mapAlong(on_slices, standard, sigma);
+}
+
 std::string diameterGainRange() {
   char text[48];
   std::snprintf(text, sizeof(text), "[%g, %g]", MIN_DIAMETER_GAIN, MAX_DIAMETER_GAIN);
@@ -206,6 +273,11 @@ std::string sensorCalibrationToYaml(const SensorCalibration& c, const std::strin
   s << "  covers:\n    trunk_radius_m: " << list({v.trunk_radius_min_m, v.trunk_radius_max_m})
     << "\n    branch_radius_m: " << list({v.branch_radius_min_m, v.branch_radius_max_m})
     << "\n    noise_m: " << list({v.noise_min_m, v.noise_max_m}) << "\n";
+  if (!c.noise_readings.empty()) {
+    s << "  noise_readings:\n";
+    for (const NoiseReading& r : c.noise_readings)
+      s << "    - radii_m: " << list(r.radii_m) << "\n      noise_m: " << list(r.noise_m) << "\n";
+  }
   s << tableYaml("trunk_footprint", c.trunk_footprint)
     << tableYaml("branch_footprint", c.branch_footprint);
   if (c.silhouette.measured) {

@@ -125,6 +125,12 @@ DiameterCorrection describeCalibration(const ModelerConfig& config, const TreeMo
   }
   d.calibration = cal.name;
   d.calibration_hash = cal.hash;
+  if (cal.noise_readings.empty()) {
+    d.warnings.push_back("calibration " + cal.name +
+                         " has no noise readings per pipe section (made by an older "
+                         "calibrate_diameters): its rows hold the whole rig's noise estimate, "
+                         "which the tree's does not match; make it again");
+  }
   const CalibrationCoverage& c = cal.coverage;
   if (sigma < c.noise_min_m * (1.0 - COVERAGE_NOISE_SLACK) ||
       sigma > c.noise_max_m * (1.0 + COVERAGE_NOISE_SLACK)) {
@@ -425,7 +431,7 @@ ModelResult TreeModeler::model(const Points& input) const {
   result.noise_sigma = trunk.noise_sigma;
   result.table_noise_sigma = trunk.table_sigma;
   watch.lap("trunk");
-  requireScannedSurface(trunk.noise_sigma);
+  requireScannedSurface(trunk.search_sigma);
   const auto branches = modelBranches(pts, index, trunk, region.points, config_,
                                       &result.rejected_branches, result.preprocess.wire_directions);
   watch.lap("branches");
@@ -442,6 +448,7 @@ ModelResult TreeModeler::model(const Points& input) const {
       result.classes[k] = PointClass::PRIMARY;
   }
   model.correction = describeCorrection(config_, model, trunk.noise_sigma, trunk.table_sigma);
+  model.correction.search_noise_sigma = trunk.search_sigma;
   model.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -47,6 +47,11 @@ constexpr double AXIS_RADIUS_WINDOW = 0.15;
 // A slice circle's centre lies within this many local radii of the centreline: the circle
 // holds the axis.
 constexpr double SLICE_CENTRE_RADII = 1.0;
+// The range noise is read on slices whose circle is at most this many times the track's local
+// radius. Honest slices read within a fifth of it; a circle through a whorl's branch bases or
+// around a scaffold beside the leader reads 1.5-2.5 times it, and its residuals measure the
+// misfit, about twice the scanner's noise.
+constexpr double NOISE_TRACK_RADII = 1.5;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -808,6 +813,20 @@ SliceBounds sliceBounds(double initial_radius) {
   return bounds;
 }
 
+/// The slices whose circle keeps within NOISE_TRACK_RADII of the track's local radius (with
+/// those that have no circle, which the estimate skips); all of them without a track.
+std::vector<Slice> slicesOnTrack(const std::vector<Slice>& slices, const TrackedAxis& track) {
+  if (track.empty())
+    return slices;
+  std::vector<Slice> out;
+  for (const auto& sl : slices) {
+    const double local = track.radiusNear(sl.center);
+    if (!sl.has_circle || local <= 0.0 || sl.radius <= NOISE_TRACK_RADII * local)
+      out.push_back(sl);
+  }
+  return out;
+}
+
 /// The region's range noise: the configured one, or estimated from the slices.
 /// With slice_radii, radii standing for the slices it was read on (none when given).
 double trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
@@ -877,7 +896,7 @@ void fitCylinders(const SegmentContext& c, TrunkModel& trunk) {
 void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
   const auto profile =
       TaperProfile::fit(trunk.slices, config.trunk.slice_height_m, TAPER_BELOW,
-                        trunk.noise_sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE);
+                        trunk.search_sigma >= TAPER_NOISY_SIGMA ? TAPER_ABOVE_NOISY : TAPER_ABOVE);
   if (!profile)
     return;
   for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
@@ -921,31 +940,34 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   const SliceBounds bounds = sliceBounds(initial_radius);
   const TrackedAxis track(initial, initial_axis, axis_radii);
   // The noise is read on slices bounded by the trunk-wide radius alone and about their own
-  // centreline, with or without a track: the calibrations' noise rows and the branch search's
-  // bands were set on that reading, and a thin branch's noise correction follows it about
-  // one for one.
+  // centreline, with or without a track: the calibration rig's sections are read alike (one
+  // section, no track). The range noise skips the slices off the track; the bands and gates
+  // that pick among clutter were set on every slice's scatter.
   SlicedAxis sliced =
       refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
-  std::vector<double> slice_radii;
-  const double sigma = trunkNoise(pts, region, sliced.line, sliced.slices, config, &slice_radii);
+  std::vector<double> slice_radii, all_radii;
+  const double sigma = trunkNoise(pts, region, sliced.line, slicesOnTrack(sliced.slices, track),
+                                  config, &slice_radii);
+  trunk.search_sigma = trunkNoise(pts, region, sliced.line, sliced.slices, config, &all_radii);
   if (!track.empty())
     sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
   trunk.noise_sigma = sigma;
-  // A calibration's rows are the estimate as its rig read it (raw radii: calibrate_diameters
-  // measuring one), and take the tree's likewise; the noise part alone models range noise, and
-  // reads it as its 5 cm slices do.
-  const bool noise_part_alone = !config.calibration.given() && !config.branches.raw_radius;
-  trunk.table_sigma = config.noise.correct_bias && noise_part_alone
+  // Raw radii (calibrate_diameters measuring a rig) key their rows on the rig's own reading.
+  trunk.table_sigma = config.noise.correct_bias && !config.branches.raw_radius
                           ? standardNoiseReading(config, sigma, slice_radii)
                           : sigma;
   const double scatter =
       config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;
   trunk.scatter = scatter;
+  // The trunk's RANSAC bands decide which circle a slice through clutter takes, like the
+  // search's gates: they keep the reading they were set on. With the range noise alone a
+  // crooked leader's slices took the wider circles around its bends, and its taper profile
+  // followed them.
   double circle_threshold = config.fit.circle_threshold_m,
          cylinder_threshold = config.fit.cylinder_threshold_m;
   if (config.noise.derive_parameters) {
-    circle_threshold = std::max(circle_threshold, noiseBand(sigma));
-    cylinder_threshold = std::max(cylinder_threshold, noiseBand(sigma));
+    circle_threshold = std::max(circle_threshold, noiseBand(trunk.search_sigma));
+    cylinder_threshold = std::max(cylinder_threshold, noiseBand(trunk.search_sigma));
   }
   if (config.fit.constrain || config.noise.derive_parameters || config.noise.correct_bias) {
     const auto expected = expectedRadii(sliced.slices);

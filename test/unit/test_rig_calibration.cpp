@@ -2,6 +2,7 @@
 // gives, the calibration file, and a tree of the rig's world measured through it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -115,6 +116,7 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   c.branch_footprint = c.trunk_footprint;
   c.coverage = {0.01, 0.05, 0.003, 0.02, 0.006, 0.006};
   c.silhouette = {true, 0.0015, 0.0085, 1.2, 3.4, 0.5, 0.4};
+  c.noise_readings = {{{0.02, 0.05}, {0.007, 0.006}}};
   const std::string path =
       dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "made by a test"));
   const auto back = modeling::loadSensorCalibration(path);
@@ -125,6 +127,9 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_EQ(back.hash.size(), 16u);
   EXPECT_TRUE(back.silhouette.measured);
   EXPECT_DOUBLE_EQ(back.silhouette.growth_per_m, 0.0085);
+  ASSERT_EQ(back.noise_readings.size(), 1u);
+  EXPECT_EQ(back.noise_readings[0].radii_m, c.noise_readings[0].radii_m);
+  EXPECT_EQ(back.noise_readings[0].noise_m, c.noise_readings[0].noise_m);
   registration::RegistrationConfig reg;
   EXPECT_TRUE(registration::applySensorCalibration(back, reg));
   EXPECT_DOUBLE_EQ(reg.axes.silhouette_growth_m, 0.5 * 0.0015);
@@ -160,6 +165,18 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
   EXPECT_EQ(code(replaced("bias_m: [0.00300", "bias_m: [0.30000")), ErrorCode::INVALID_ARGUMENT);
   EXPECT_EQ(code(replaced("covers:", "coverage:")), ErrorCode::PARSE_ERROR);
   EXPECT_EQ(code(replaced("noise_m: [0.00600]", "noise_m: six")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(replaced("noise_m: [0.00700, 0.00600]", "noise_m: [0.00700]")),
+            ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(replaced("noise_m: [0.00700, 0.00600]", "noise_m: [0.00700, 0.00000]")),
+            ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(replaced("- radii_m: [0.02000", "- radius_m: [0.02000")), ErrorCode::PARSE_ERROR);
+  // Files from before the readings were recorded load; the modeler says they are old.
+  const std::string no_readings = replaced(
+      "  noise_readings:\n    - radii_m: [0.02000, 0.05000]\n      noise_m: "
+      "[0.00700, 0.00600]\n",
+      "");
+  EXPECT_TRUE(
+      modeling::loadSensorCalibration(dir.write("older.yaml", no_readings)).noise_readings.empty());
   // A gain this low would multiply the width's noise tenfold into the radius.
   EXPECT_EQ(code(replaced("diameter_gain: [0.40000]", "diameter_gain: [0.10000]")),
             ErrorCode::INVALID_ARGUMENT);
@@ -275,6 +292,27 @@ TEST(SensorCalibrationFile, TheShippedSensorModelCalibrationLoads) {
   EXPECT_LE(c.coverage.branch_radius_min_m, 0.003);
 }
 
+TEST(SensorCalibrationFile, MapsATreesNoiseReadingToTheRigsFiveCentimetreSection) {
+  modeling::SensorCalibration c;
+  c.name = "two scans";
+  // Two rig scans: the thin sections read more than the 5 cm one (a footprint), at two noises.
+  c.noise_readings = {{{0.02, 0.05, 0.10}, {0.008, 0.006, 0.004}},
+                      {{0.02, 0.05, 0.10}, {0.012, 0.010, 0.008}}};
+  EXPECT_DOUBLE_EQ(c.noise_readings[0].at(0.035), 0.007);
+  EXPECT_DOUBLE_EQ(c.noise_readings[0].at(0.01), 0.008);  // held beyond the sections
+  EXPECT_DOUBLE_EQ(c.noise_readings[1].at(0.2), 0.008);
+  // A tree read on 2 cm slices: the scans read 8 and 12 mm there, 6 and 10 mm on 5 cm.
+  EXPECT_NEAR(c.standardReading(0.008, {0.02}), 0.006, 1e-12);
+  EXPECT_NEAR(c.standardReading(0.010, {0.02, 0.02}), 0.008, 1e-12);
+  EXPECT_NEAR(c.standardReading(0.016, {0.02}), 0.016 * 0.010 / 0.012, 1e-12);
+  EXPECT_NEAR(c.standardReading(0.004, {0.02}), 0.004 * 0.006 / 0.008, 1e-12);
+  // Slices of 2 and 10 cm: the scans read their mean, 6 and 10 mm, as on 5 cm.
+  EXPECT_NEAR(c.standardReading(0.009, {0.02, 0.10}), 0.009, 1e-12);
+  // Nothing to map with: the estimate as read.
+  EXPECT_DOUBLE_EQ(c.standardReading(0.009, {}), 0.009);
+  EXPECT_DOUBLE_EQ(modeling::SensorCalibration{}.standardReading(0.009, {0.02}), 0.009);
+}
+
 /// The simulated rig scanned with the whole plan at 6 mm noise, once for the suite.
 class RigCalibration : public ::testing::Test {
  protected:
@@ -320,6 +358,16 @@ TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
   EXPECT_LT(std::abs(c.trunk_footprint.bias.back()), 0.001);
   EXPECT_NEAR(c.coverage.branch_radius_min_m, 0.002, 1e-9);
   EXPECT_NEAR(c.coverage.trunk_radius_max_m, 0.1, 1e-9);
+  // The noise read section by section; the rows are keyed on the 5 cm section's reading.
+  ASSERT_EQ(c.noise_readings.size(), 1u);
+  const auto& reading = c.noise_readings[0];
+  EXPECT_GE(reading.radii_m.size(), 4u);
+  EXPECT_NEAR(reading.radii_m.back(), 0.1, 1e-9);
+  const double standard = reading.at(modeling::STANDARD_READING_RADIUS_M);
+  EXPECT_GT(standard, 0.004);
+  EXPECT_LT(standard, 0.009);
+  EXPECT_DOUBLE_EQ(c.coverage.noise_min_m, standard);
+  EXPECT_EQ(c.trunk_footprint.noise, std::vector<double>{standard});
 }
 
 TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {
@@ -446,10 +494,24 @@ TEST_F(RigCalibration, ATreeOfTheSameWorldMeasuresWithinBoundsAndSaysWhichCalibr
   ASSERT_FALSE(plain.correction.warnings.empty());
   EXPECT_NE(plain.correction.warnings[0].find("no sensor calibration"), std::string::npos);
   EXPECT_TRUE(plain.correction.calibration.empty());
-  // The rig's rows are the estimate as read: a calibrated tree looks its own up likewise. The
-  // noise part alone reads it as 5 cm slices would (this tree's trunk is thinner: more).
-  EXPECT_EQ(model.correction.table_noise_sigma, model.correction.noise_sigma);
+  // The rig's rows are keyed on its 5 cm section's reading, and a calibrated tree's estimate
+  // is mapped to it through the rig's readings: the same scanner at the same noise lands
+  // near the rig's row. The noise part alone reads it as 5 cm slices would through the
+  // estimator's model (this tree's trunk is thinner: more).
+  const double row = result.calibration.coverage.noise_min_m;
+  EXPECT_NEAR(model.correction.table_noise_sigma, row, 0.15 * row);
+  EXPECT_NE(model.correction.table_noise_sigma, model.correction.noise_sigma);
   EXPECT_GT(plain.correction.table_noise_sigma, plain.correction.noise_sigma);
+  // The search's scatter reads every slice, the range noise those on the track.
+  EXPECT_GE(model.correction.search_noise_sigma, model.correction.noise_sigma);
+  EXPECT_DOUBLE_EQ(back.correction.search_noise_sigma, model.correction.search_noise_sigma);
+  // A file made before the readings were recorded: the model says so.
+  config.calibration.noise_readings.clear();
+  const auto older = modeling::TreeModeler(config).model(cloud).model;
+  const auto& said = older.correction.warnings;
+  EXPECT_TRUE(std::any_of(said.begin(), said.end(), [](const std::string& w) {
+    return w.find("no noise readings per pipe section") != std::string::npos;
+  }));
 }
 
 }  // namespace

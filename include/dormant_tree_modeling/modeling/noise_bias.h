@@ -24,9 +24,10 @@ RadiusCalibration branchNoiseBias(const ModelerConfig& config);
 /// whose slices are not much thicker than the noise it reads less than on the 5 cm slices the
 /// tables' noise axis stands for, and thin branches came out too thick (12 mm range noise, no
 /// footprint, no calibration: +5.9 mm). Maps an estimate read on slices of `slice_radii` to
-/// what 5 cm slices give for the same range noise, through the estimator's modelled readings.
-/// Range noise only: a footprint's widening reads otherwise (thinner trunks read more), so the
-/// modeler applies this without a calibration only (TrunkModel::table_sigma).
+/// what 5 cm slices give for the same noise: with a calibration through its rig's readings
+/// (SensorCalibration::standardReading), without one through the estimator's modelled readings,
+/// which cover range noise only (a footprint's widening reads otherwise: thinner trunks read
+/// more). TrunkModel::table_sigma.
 /// @param sigma the estimate (m)
 /// @param slice_radii radii standing for the slices it was read on (m); none leaves sigma
 double standardNoiseReading(const ModelerConfig& config, double sigma,

@@ -8,6 +8,10 @@ namespace modeling {
 /// @brief Whether every value is larger than the one before (true for fewer than two).
 bool strictlyAscending(const std::vector<double>& values);
 
+/// @brief Piecewise-linear map of v from the ascending axis `from` onto `to` (same length, not
+/// empty); below and above the ends in proportion to the end value (from's ends positive).
+double mapAlong(const std::vector<double>& from, const std::vector<double>& to, double v);
+
 /// @brief Systematic radius error of the trunk's slice estimate, apparent minus true, as a
 /// table over the true radius and the range noise the modeler estimates. A laser beam that
 /// partly hits a thin object reports its range along the beam centre, so each silhouette edge

@@ -36,6 +36,22 @@ constexpr bool validDiameterGain(double gain) {
 /// @brief "[min, max]" of the diameter gain, for messages.
 std::string diameterGainRange();
 
+/// @brief The radius of the slices whose noise reading is the standard one (m): the noise axis
+/// of every radius table (the noise part's and a calibration's) is what the modeler's noise
+/// estimate reads on slices of this radius.
+constexpr double STANDARD_READING_RADIUS_M = 0.05;
+
+/// @brief What the modeler's noise estimate read on each pipe section of one rig scan, over
+/// the sections' true radii: how one scanner's reading of the same noise varies with the
+/// trunk's radius (a footprint reads more on thin sections, range noise alone less).
+struct NoiseReading {
+  std::vector<double> radii_m;  ///< the sections' true radii, ascending
+  std::vector<double> noise_m;  ///< the estimate on each (m)
+
+  /// @brief The reading at a radius: linear between sections, held beyond them; 0 when empty.
+  double at(double radius) const;
+};
+
 /// @brief The part of one scanner's radius bias that range noise does not explain: the beam
 /// footprint's widening of thin objects (apparent minus true radius, m, over the true radius
 /// and the estimated noise, after the noise part of noise_bias.h is taken off). Made by
@@ -62,10 +78,18 @@ struct SensorCalibration {
     /// look alike (a radius read from the width then divides by it).
     double diameter_gain = 1.0;
   } silhouette;
+  /// One per rig scan; the tables' noise axis is their readings at STANDARD_READING_RADIUS_M.
+  /// Empty in files made before they were recorded: their rows hold the whole rig's estimate.
+  std::vector<NoiseReading> noise_readings;
   std::vector<std::string> sources;  ///< the scans it was made from, for the record
 
   /// @brief Whether a calibration is set.
   bool given() const { return !name.empty(); }
+  /// @brief An estimate read on slices of `slice_radii` mapped to what this scanner's
+  /// STANDARD_READING_RADIUS_M sections read for the same noise, through the rig scans'
+  /// readings (between scans linear, beyond them in proportion); sigma itself without
+  /// readings or radii.
+  double standardReading(double sigma, const std::vector<double>& slice_radii) const;
 };
 
 /// @brief FNV-1a 64 of bytes, as 16 lower-case hex digits.

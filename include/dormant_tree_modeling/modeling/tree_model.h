@@ -49,9 +49,12 @@ struct DiameterCorrection {
   std::string calibration;       ///< the sensor calibration's name; empty: none was given
   std::string calibration_hash;  ///< of its file (SensorCalibration::hash)
   double noise_sigma = 0.0;      ///< m, the range noise the modeler estimated (or was given)
-  /// m, that estimate as the radius tables read it: without a calibration what 5 cm slices
-  /// would read (standardNoiseReading), with one the estimate itself, as its rig's rows are
+  /// m, that estimate as the radius tables read it: what 5 cm slices would read for the same
+  /// noise (standardNoiseReading; with a calibration through its rig's readings)
   double table_noise_sigma = 0.0;
+  /// m, the scatter about every trunk slice circle, whorls included, which the branch search's
+  /// noise gates take (TrunkModel::search_sigma)
+  double search_noise_sigma = 0.0;
   /// Each said once: no calibration (noise part only), or the tree needing the tables outside
   /// the radii or noise the calibration's rig covered.
   std::vector<std::string> warnings;

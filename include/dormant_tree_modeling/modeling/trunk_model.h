@@ -70,10 +70,18 @@ struct TrunkModel {
   std::vector<double> partitions;   ///< arc lengths of the segment bounds, first 0, last = top
   std::vector<Cylinder> cylinders;  ///< one per segment, bottom to top (failed fits left out)
   std::vector<std::pair<double, double>> cylinder_ranges;  ///< arc-length range of each cylinder
-  double noise_sigma = 0.0;                                ///< range noise estimate (m)
-  /// The estimate as the radius tables read it (m): without a calibration what 5 cm slices give
-  /// for the same range noise (standardNoiseReading); with a calibration, with raw branch radii
-  /// (calibrate_diameters measuring a rig) or without the bias correction, noise_sigma.
+  /// Range noise estimate (m), read on the slices whose circle keeps to the trunk's tracked
+  /// radius: the fits' bands, the scatter taken off radii and the tables take it.
+  double noise_sigma = 0.0;
+  /// The scatter about every slice circle (m), those through whorls and around scaffolds
+  /// included: what the trunk's RANSAC bands, the branch search's noise gates and its
+  /// extraction reach were set on, and what tells a scanned surface from clutter. Above
+  /// noise_sigma on a tree with whorls.
+  double search_sigma = 0.0;
+  /// The estimate as the radius tables read it (m): what a 5 cm slice gives for the same noise
+  /// (standardNoiseReading: through the calibration rig's readings, or without a calibration
+  /// the estimator's modelled ones); with raw branch radii (calibrate_diameters measuring a rig)
+  /// or without the bias correction, noise_sigma.
   double table_sigma = 0.0;
   /// Total scatter removed from radii: sqrt(noise_sigma^2 + beam_spread^2) when the bias
   /// correction is on, else 0 (m).
