@@ -192,8 +192,8 @@ std::vector<RigSample> measureSections(const RigScan& scan, const modeling::Mode
 
 /// The scan's reading at STANDARD_READING_RADIUS_M, which keys its rows; its sections' readings
 /// sorted by radius (equal radii averaged).
-double standardReading(const RigScan& scan, modeling::NoiseReading* reading,
-                       std::vector<std::string>* warnings) {
+double scanStandardReading(const RigScan& scan, modeling::NoiseReading* reading,
+                           std::vector<std::string>* warnings) {
   std::map<double, std::pair<double, int>> by_radius;
   for (std::size_t i = 0; i < reading->radii_m.size(); ++i) {
     auto& e = by_radius[reading->radii_m[i]];
@@ -647,7 +647,7 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
     recentre(scan);
     modeling::NoiseReading reading;
     auto sections = measureSections(scan, raw, search, &reading, &result.warnings);
-    const double sigma = standardReading(scan, &reading, &result.warnings);
+    const double sigma = scanStandardReading(scan, &reading, &result.warnings);
     auto rods = measureRods(scan, raw, search, sigma, &result.warnings);
     for (auto& s : rods)
       s.noise_part = branch_noise.biasAt(s.radius, sigma);
