@@ -567,6 +567,28 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_EQ(reasons["too low"], 1);
 }
 
+TEST(BranchModel, AThickWireWhoseReturnsSpreadIsStillAWire) {
+  // A 4 mm trellis wire 6 cm from the trunk's axis, as the scanner sees it: its returns spread
+  // about 5 mm round its line (footprint and noise), wider than the wire. Its two sides are
+  // found as pieces of a thin level line that continues past the trunk: a wire, not branches.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
+  const std::size_t trunk_points = pts.size();
+  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);  // a primary
+  addCylinder(pts, {-0.6, 0.06, 1.2}, {1, 0, 0}, 0.005, 0.56);  // the wire, one side
+  addCylinder(pts, {0.04, 0.06, 1.2}, {1, 0, 0}, 0.005, 0.56);  // and the other
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
+  std::vector<RejectedBranch> rejected;
+  const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config, &rejected);
+  ASSERT_EQ(branches.size(), 1u);
+  EXPECT_GT(branches[0].cylinder.axis.dot(Eigen::Vector3d(1, 0.1, 0.2).normalized()),
+            std::cos(5.0 * M_PI / 180));
+  int wires = 0;
+  for (const auto& r : rejected)
+    wires += r.reason == BranchRejection::WIRE;
+  EXPECT_EQ(wires, 2);
+}
+
 TEST(BranchModel, OppositeThinBranchesAcrossTheRowAreNoWire) {
   // Two thin level branches leave the trunk in opposite directions at one height: each
   // continues the other's line through the trunk, as a wire would. The row's wires run along
