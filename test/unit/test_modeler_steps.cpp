@@ -574,7 +574,7 @@ TEST(BranchModel, AThickWireWhoseReturnsSpreadIsStillAWire) {
   Points pts;
   addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
   const std::size_t trunk_points = pts.size();
-  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);  // a primary
+  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);   // a primary
   addCylinder(pts, {-0.6, 0.06, 1.2}, {1, 0, 0}, 0.005, 0.56);  // the wire, one side
   addCylinder(pts, {0.04, 0.06, 1.2}, {1, 0, 0}, 0.005, 0.56);  // and the other
   auto [region, config, trunk] = buildTrunk(pts, trunk_points);
