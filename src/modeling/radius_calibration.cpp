@@ -10,17 +10,6 @@ namespace {
 
 constexpr double MAX_NOISE_EXTRAPOLATION = 1.0;
 
-/// Index of the lower grid point and the fraction towards the next, clamped to the grid.
-std::pair<std::size_t, double> locate(const std::vector<double>& grid, double x) {
-  if (grid.size() < 2 || x <= grid.front())
-    return {0, 0.0};
-  if (x >= grid.back())
-    return {grid.size() - 2, 1.0};
-  const std::size_t i =
-      static_cast<std::size_t>(std::upper_bound(grid.begin(), grid.end(), x) - grid.begin()) - 1;
-  return {i, (x - grid[i]) / (grid[i + 1] - grid[i])};
-}
-
 }  // namespace
 
 bool strictlyAscending(const std::vector<double>& values) {
@@ -43,12 +32,12 @@ double RadiusCalibration::biasAt(double radius, double sigma) const {
   auto row = [&](std::size_t k) {
     if (n == 1)
       return bias[k * n];
-    const auto [i, t] = locate(radii, radius);
+    const auto [i, t] = gridPosition(radii, radius);
     return (1.0 - t) * bias[k * n + i] + t * bias[k * n + i + 1];
   };
   if (noise.size() == 1)
     return row(0);
-  auto [k, u] = locate(noise, sigma);
+  auto [k, u] = gridPosition(noise, sigma);
   // Past the noisiest row the bias keeps growing with the noise: continue the last two rows'
   // line (up to MAX_NOISE_EXTRAPOLATION of their spacing) rather than hold the last row.
   if (sigma > noise.back()) {
@@ -74,6 +63,16 @@ double RadiusCalibration::correct(double apparent, double sigma, double min_radi
     (excess(mid) < 0.0 ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+std::pair<std::size_t, double> gridPosition(const std::vector<double>& grid, double x) {
+  if (grid.size() < 2 || x <= grid.front())
+    return {0, 0.0};
+  if (x >= grid.back())
+    return {grid.size() - 2, 1.0};
+  const std::size_t i =
+      static_cast<std::size_t>(std::upper_bound(grid.begin(), grid.end(), x) - grid.begin()) - 1;
+  return {i, (x - grid[i]) / (grid[i + 1] - grid[i])};
 }
 
 double mapAlong(const std::vector<double>& from, const std::vector<double>& to, double v) {

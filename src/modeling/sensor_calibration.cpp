@@ -25,17 +25,23 @@ constexpr double MAX_NOISE_M = 0.1;
   throw Error(code, "calibration file " + path + ": " + what);
 }
 
+/// `n` (named `where`) as a map with only the `allowed` keys.
+void requireMap(const YAML::Node& n, const std::string& where, const std::set<std::string>& allowed,
+                const std::string& path) {
+  if (!n || !n.IsMap())
+    fail(ErrorCode::PARSE_ERROR, path, "'" + where + "' is missing or not a map");
+  for (const auto& kv : n) {
+    const std::string k = kv.first.as<std::string>();
+    if (!allowed.count(k))
+      fail(ErrorCode::PARSE_ERROR, path, "unknown key '" + where + "." + k + "'");
+  }
+}
+
 /// The map under `key`, with only the `allowed` keys.
 YAML::Node section(const YAML::Node& parent, const std::string& key,
                    const std::set<std::string>& allowed, const std::string& path) {
   const YAML::Node n = parent[key];
-  if (!n || !n.IsMap())
-    fail(ErrorCode::PARSE_ERROR, path, "'" + key + "' is missing or not a map");
-  for (const auto& kv : n) {
-    const std::string k = kv.first.as<std::string>();
-    if (!allowed.count(k))
-      fail(ErrorCode::PARSE_ERROR, path, "unknown key '" + key + "." + k + "'");
-  }
+  requireMap(n, key, allowed, path);
   return n;
 }
 
@@ -84,13 +90,7 @@ std::vector<NoiseReading> readNoiseReadings(const YAML::Node& root, const std::s
     fail(ErrorCode::PARSE_ERROR, path, "'noise_readings' is not a list");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string where = "noise_readings[" + std::to_string(i) + "]";
-    if (!list[i].IsMap())
-      fail(ErrorCode::PARSE_ERROR, path, "'" + where + "' is not a map");
-    for (const auto& kv : list[i]) {
-      const std::string k = kv.first.as<std::string>();
-      if (k != "radii_m" && k != "noise_m")
-        fail(ErrorCode::PARSE_ERROR, path, "unknown key '" + where + "." + k + "'");
-    }
+    requireMap(list[i], where, {"radii_m", "noise_m"}, path);
     NoiseReading r{numbers(list[i], "radii_m", where, path),
                    numbers(list[i], "noise_m", where, path)};
     const bool noise_ok = std::all_of(r.noise_m.begin(), r.noise_m.end(),
@@ -220,15 +220,10 @@ SensorCalibration loadSensorCalibration(const std::string& path) {
 }
 
 double NoiseReading::at(double radius) const {
-  if (radii_m.empty())
-    return 0.0;
-  if (radius <= radii_m.front())
-    return noise_m.front();
-  if (radius >= radii_m.back())
-    return noise_m.back();
-  const std::size_t k = std::upper_bound(radii_m.begin(), radii_m.end(), radius) - radii_m.begin();
-  const double t = (radius - radii_m[k - 1]) / (radii_m[k] - radii_m[k - 1]);
-  return noise_m[k - 1] + t * (noise_m[k] - noise_m[k - 1]);
+  if (radii_m.size() < 2)
+    return radii_m.empty() ? 0.0 : noise_m.front();
+  const auto [i, t] = gridPosition(radii_m, radius);
+  return (1.0 - t) * noise_m[i] + t * noise_m[i + 1];
 }
 
 double SensorCalibration::standardReading(double sigma,

@@ -827,20 +827,35 @@ std::vector<Slice> slicesOnTrack(const std::vector<Slice>& slices, const Tracked
   return out;
 }
 
-/// The region's range noise: the configured one, or estimated from the slices.
-/// With slice_radii, radii standing for the slices it was read on (none when given).
-double trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
-                  const std::vector<Slice>& slices, const ModelerConfig& config,
-                  std::vector<double>* slice_radii) {
-  slice_radii->clear();
-  if (config.noise.sigma_m >= 0.0)
-    return config.noise.sigma_m;
+/// The region's two noise readings (TrunkModel::noise_sigma, search_sigma), m.
+struct TrunkNoise {
+  double range = 0.0;               ///< on the slices that keep to the track
+  double search = 0.0;              ///< over every slice
+  std::vector<double> slice_radii;  ///< standing for the slices `range` was read on
+};
+
+/// The region's noise: the configured one, or estimated from the slices; read once over every
+/// slice and again on those on the track when some were left out.
+TrunkNoise trunkNoise(const Points& pts, const std::vector<int>& region, const Centerline& line,
+                      const std::vector<Slice>& slices, const TrackedAxis& track,
+                      const ModelerConfig& config) {
+  TrunkNoise n;
+  if (config.noise.sigma_m >= 0.0) {
+    n.range = n.search = config.noise.sigma_m;
+    return n;
+  }
   Points region_pts;
   for (const int i : region)
     region_pts.push_back(pts[i]);
-  const double estimate =
-      estimateNoiseSigma(region_pts, line, slices, config.trunk.slice_height_m, slice_radii);
-  return estimate > 0.0 ? estimate : 0.0;
+  const double h = config.trunk.slice_height_m;
+  const std::vector<Slice> on_track = slicesOnTrack(slices, track);
+  n.search = std::max(
+      0.0, estimateNoiseSigma(region_pts, line, slices, h,
+                              on_track.size() == slices.size() ? &n.slice_radii : nullptr));
+  n.range = on_track.size() == slices.size()
+                ? n.search
+                : std::max(0.0, estimateNoiseSigma(region_pts, line, on_track, h, &n.slice_radii));
+  return n;
 }
 
 /// The segment boundaries along the centreline: disturbance partitions, short ones joined,
@@ -945,16 +960,15 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   // that pick among clutter were set on every slice's scatter.
   SlicedAxis sliced =
       refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
-  std::vector<double> slice_radii, all_radii;
-  const double sigma = trunkNoise(pts, region, sliced.line, slicesOnTrack(sliced.slices, track),
-                                  config, &slice_radii);
-  trunk.search_sigma = trunkNoise(pts, region, sliced.line, sliced.slices, config, &all_radii);
+  const TrunkNoise noise = trunkNoise(pts, region, sliced.line, sliced.slices, track, config);
+  const double sigma = noise.range;
+  trunk.search_sigma = noise.search;
   if (!track.empty())
     sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
   trunk.noise_sigma = sigma;
   // Raw radii (calibrate_diameters measuring a rig) key their rows on the rig's own reading.
   trunk.table_sigma = config.noise.correct_bias && !config.branches.raw_radius
-                          ? standardNoiseReading(config, sigma, slice_radii)
+                          ? standardNoiseReading(config, sigma, noise.slice_radii)
                           : sigma;
   const double scatter =
       config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;

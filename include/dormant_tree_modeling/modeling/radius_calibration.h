@@ -1,5 +1,6 @@
 #pragma once
 
+#include <utility>
 #include <vector>
 
 namespace dormant_tree_modeling {
@@ -7,6 +8,10 @@ namespace modeling {
 
 /// @brief Whether every value is larger than the one before (true for fewer than two).
 bool strictlyAscending(const std::vector<double>& values);
+
+/// @brief Where x lies on an ascending grid: the index of the grid point below it and the
+/// fraction towards the next, clamped to the grid ({0, 0} for fewer than two points).
+std::pair<std::size_t, double> gridPosition(const std::vector<double>& grid, double x);
 
 /// @brief Piecewise-linear map of v from the ascending axis `from` onto `to` (same length, not
 /// empty); below and above the ends in proportion to the end value (from's ends positive).
