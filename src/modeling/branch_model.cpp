@@ -72,10 +72,12 @@ BranchBands branchBands(const TrunkModel& trunk, const ModelerConfig& config) {
 /// The candidate points: in the paper's way the points of `region` off their trunk segment's
 /// cylinder; with branches.shell every point in a shell around the trunk cylinders, which
 /// starts away from the trunk because near its surface the trunk's noise links every branch
-/// to every other. Located on all cores, kept in index order.
+/// to every other. Points flagged in `not_branches` (another column's surface) are left out.
+/// Located on all cores, kept in index order.
 BranchCandidates collectCandidates(const Points& pts, const TrunkModel& trunk,
                                    const std::vector<int>& region, const ModelerConfig& config,
-                                   const BranchBands& bands) {
+                                   const BranchBands& bands,
+                                   const std::vector<char>& not_branches) {
   const double s_lo = trunk.cylinder_ranges.front().first - SHELL_AXIAL_MARGIN;
   const double s_hi = trunk.cylinder_ranges.back().second + SHELL_AXIAL_MARGIN;
   const bool shell = config.branches.shell;
@@ -94,6 +96,8 @@ BranchCandidates collectCandidates(const Points& pts, const TrunkModel& trunk,
                   c.distance > r + config.branches.fit_length_m + SHELL_OUTER_MARGIN))
       continue;
     const int i = shell ? k : region[k];
+    if (!not_branches.empty() && not_branches[i])
+      continue;
     out.index.push_back(i);
     out.where.push_back(c);
     out.pts.push_back(pts[i]);
@@ -272,11 +276,13 @@ std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,
                                      std::vector<RejectedBranch>* rejected,
-                                     const std::vector<Eigen::Vector3d>& wire_directions) {
+                                     const std::vector<Eigen::Vector3d>& wire_directions,
+                                     const std::vector<char>& not_branches) {
   if (trunk.cylinders.empty())
     return {};
   const BranchBands bands = branchBands(trunk, config);
-  const BranchCandidates candidates = collectCandidates(pts, trunk, region, config, bands);
+  const BranchCandidates candidates =
+      collectCandidates(pts, trunk, region, config, bands, not_branches);
   const auto clusters = euclideanClusters(candidates.pts, config.branches.cluster_tolerance_m,
                                           config.branches.min_points);
   detail::BranchSearch search({index, trunk, config, bands, wire_directions}, candidates, rejected);

@@ -416,9 +416,10 @@ ModelResult TreeModeler::model(const Points& input) const {
   // Algorithm 3 on the trunk region: Algorithm 2's, or (ours) the points around the best
   // tracked trunk.
   TrunkRegion region = pathRegion(clusters, path);
+  std::vector<TrackedTrunk> columns;
   if (config_.graph.follow_diameter) {
-    if (const auto tracked =
-            trackBestTrunk(pts, index, clusters, path, config_, &result.trunk_candidates)) {
+    if (const auto tracked = trackBestTrunk(pts, index, clusters, path, config_,
+                                            &result.trunk_candidates, &columns)) {
       region.axis = tracked->centers;
       region.radius = median(tracked->radii);
       region.radii = tracked->radii;
@@ -432,8 +433,13 @@ ModelResult TreeModeler::model(const Points& input) const {
   result.table_noise_sigma = trunk.table_sigma;
   watch.lap("trunk");
   requireScannedSurface(trunk.search_sigma);
-  const auto branches = modelBranches(pts, index, trunk, region.points, config_,
-                                      &result.rejected_branches, result.preprocess.wire_directions);
+  const double column_band =
+      std::max(config_.fit.cylinder_threshold_m, noiseBand(trunk.search_sigma));
+  const std::vector<char> on_columns = pointsOnColumns(pts, columns, column_band);
+  result.column_points = static_cast<int>(std::count(on_columns.begin(), on_columns.end(), 1));
+  const auto branches =
+      modelBranches(pts, index, trunk, region.points, config_, &result.rejected_branches,
+                    result.preprocess.wire_directions, on_columns);
   watch.lap("branches");
 
   TreeModel& model = result.model;

@@ -154,6 +154,32 @@ TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkSt
   return tracked;
 }
 
+/// How far p lies outside a track's surface, read across its axis at p's height (centre and
+/// radius interpolated between the circles around it); nothing outside the track's span.
+std::optional<double> surfaceGapAt(const TrackedTrunk& t, const Eigen::Vector3d& p) {
+  const auto& c = t.centers;
+  if (c.size() < 2 || p.z() < c.front().z() || p.z() > c.back().z())
+    return std::nullopt;
+  const auto above = std::upper_bound(c.begin() + 1, c.end() - 1, p.z(),
+                                      [](double z, const Eigen::Vector3d& q) { return z < q.z(); });
+  const std::size_t i = above - c.begin();
+  const double dz = c[i].z() - c[i - 1].z();
+  const double f = dz > 1e-9 ? std::clamp((p.z() - c[i - 1].z()) / dz, 0.0, 1.0) : 0.0;
+  const Eigen::Vector2d axis = c[i - 1].head<2>() + f * (c[i].head<2>() - c[i - 1].head<2>());
+  return (p.head<2>() - axis).norm() - (t.radii[i - 1] + f * (t.radii[i] - t.radii[i - 1]));
+}
+
+/// Whether track b keeps clear of track a's surface: at each of b's circles within a's span
+/// the gap between their surfaces exceeds `band` (m).
+bool keepsClear(const TrackedTrunk& a, const TrackedTrunk& b, double band) {
+  for (std::size_t k = 0; k < b.centers.size(); ++k) {
+    const auto gap = surfaceGapAt(a, b.centers[k]);
+    if (gap && *gap - b.radii[k] <= band)
+      return false;
+  }
+  return true;
+}
+
 /// Branch points in the shell around a track, weighted down for a start far from the crop's
 /// centre, a track floating above the ground and one that does not taper (a post).
 double trackScore(const PointIndex& index, const TrackedTrunk& tracked, const TrunkStart& start,
@@ -218,22 +244,41 @@ TrackGroups groupTracks(const std::vector<std::optional<TrackedTrunk>>& tracks) 
   return g;
 }
 
-/// A group's representative: among its tracks that stray alike from the others (within
-/// STRAY_TIE per other track; two tracks always stray alike), the one reaching highest, since
-/// a track can stop early at a whorl.
+/// A group's voters: its tracks that climb at least VOTING_HEIGHT of the group's height above
+/// `zmin`. A track that stopped at a whorl low on the trunk neither scores nor represents it.
+std::vector<char> groupVoters(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                              const TrackGroups& g, int group, double zmin) {
+  const int m = static_cast<int>(tracks.size());
+  double group_top = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < m; ++k) {
+    if (g.group[k] == group)
+      group_top = std::max(group_top, tracks[k]->centers.back().z());
+  }
+  std::vector<char> voters(m, 0);
+  for (int k = 0; k < m; ++k) {
+    voters[k] = g.group[k] == group &&
+                tracks[k]->centers.back().z() - zmin >= VOTING_HEIGHT * (group_top - zmin);
+  }
+  return voters;
+}
+
+/// A group's representative: among its voters that stray alike from the other voters (within
+/// STRAY_TIE per other voter; two always stray alike), the one reaching highest, since a track
+/// can stop early at a whorl. A short track is no judge: its offsets are read over its own
+/// height only, where a track that follows a scaffold has not left the trunk yet.
 int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const TrackGroups& g,
-                   int group) {
+                   const std::vector<char>& voters) {
   const int m = static_cast<int>(tracks.size());
   std::vector<double> stray(m, std::numeric_limits<double>::infinity());
   double least = std::numeric_limits<double>::infinity();
   int others = -1;
   for (int k = 0; k < m; ++k) {
-    if (g.group[k] != group)
+    if (!voters[k])
       continue;
     ++others;
     stray[k] = 0.0;
     for (int o = 0; o < m; ++o) {
-      if (o != k && g.group[o] == group)
+      if (o != k && voters[o])
         stray[k] += std::min(g.mean_offset[k][o], 1.0);
     }
     least = std::min(least, stray[k]);
@@ -241,7 +286,7 @@ int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const
   int chosen = -1;
   double highest = -std::numeric_limits<double>::infinity();
   for (int k = 0; k < m; ++k) {
-    if (g.group[k] == group && stray[k] <= least + STRAY_TIE * others &&
+    if (voters[k] && stray[k] <= least + STRAY_TIE * others &&
         tracks[k]->centers.back().z() > highest) {
       highest = tracks[k]->centers.back().z();
       chosen = k;
@@ -259,15 +304,10 @@ int chooseTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
   int chosen = -1;
   double best_score = -1.0;
   for (int group = 0; group < m; ++group) {
-    double group_top = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < m; ++k) {
-      if (g.group[k] == group)
-        group_top = std::max(group_top, tracks[k]->centers.back().z());
-    }
+    const std::vector<char> voters = groupVoters(tracks, g, group, zmin);
     std::vector<double> member_scores;
     for (int k = 0; k < m; ++k) {
-      if (g.group[k] == group &&
-          tracks[k]->centers.back().z() - zmin >= VOTING_HEIGHT * (group_top - zmin))
+      if (voters[k])
         member_scores.push_back(scores[k]);
     }
     if (member_scores.empty())
@@ -276,15 +316,15 @@ int chooseTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
     if (score <= best_score)
       continue;
     best_score = score;
-    chosen = representative(tracks, g, group);
+    chosen = representative(tracks, g, voters);
   }
   return chosen;
 }
 
 std::vector<TrunkCandidate> candidateReport(const std::vector<TrunkStart>& starts,
                                             const std::vector<std::optional<TrackedTrunk>>& tracks,
-                                            const std::vector<double>& scores, const TrackGroups& g,
-                                            int chosen) {
+                                            const std::vector<double>& scores,
+                                            const std::vector<int>& groups, int chosen) {
   std::vector<TrunkCandidate> report(starts.size());
   for (std::size_t k = 0; k < starts.size(); ++k) {
     TrunkCandidate& r = report[k];
@@ -300,7 +340,7 @@ std::vector<TrunkCandidate> candidateReport(const std::vector<TrunkStart>& start
     r.top = tracks[k]->centers.back().z();
     r.median_radius = median(tracks[k]->radii);
     r.score = scores[k];
-    r.group = g.group[k];
+    r.group = groups[k];
     r.chosen = static_cast<int>(k) == chosen;
   }
   return report;
@@ -463,12 +503,41 @@ std::vector<TrunkStart> standingStarts(const std::vector<TrunkStart>& starts,
   return out;
 }
 
+/// The representatives of the groups other than the chosen track's whose tracks stand and keep
+/// clear of it (trackBestTrunk's `columns`): their indices.
+std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                              const std::vector<TrunkStart>& starts, const TrackGroups& g,
+                              int chosen, double band, const SearchFrame& frame) {
+  std::vector<int> out;
+  for (int group = 0; group < static_cast<int>(tracks.size()); ++group) {
+    if (group == g.group[chosen] ||
+        std::find(g.group.begin(), g.group.end(), group) == g.group.end())
+      continue;
+    const int k = representative(tracks, g, groupVoters(tracks, g, group, frame.zmin));
+    const double climb = tracks[k]->centers.back().z() - starts[k].base.z();
+    if (climb >= STANDING_CLIMB * (frame.zmax - starts[k].base.z()) &&
+        keepsClear(*tracks[chosen], *tracks[k], band) &&
+        keepsClear(*tracks[k], *tracks[chosen], band))
+      out.push_back(k);
+  }
+  return out;
+}
+
 }  // namespace
+
+int chooseTrunkTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                     const std::vector<double>& scores, double zmin, std::vector<int>* groups) {
+  const TrackGroups g = groupTracks(tracks);
+  if (groups)
+    *groups = g.group;
+  return chooseTrack(tracks, scores, g, zmin);
+}
 
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
                                            const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config,
-                                           std::vector<TrunkCandidate>* report) {
+                                           std::vector<TrunkCandidate>* report,
+                                           std::vector<TrackedTrunk>* columns) {
   const SearchFrame frame = searchFrame(pts, clusters);
   std::vector<TrunkStart> starts = clusterTrunkStarts(clusters, path, frame.zmin, config);
   const double threshold = trackingThreshold(pts, clusters, starts, config);
@@ -490,10 +559,32 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   }
   const TrackGroups groups = groupTracks(tracks);
   const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
-  *report = candidateReport(starts, tracks, scores, groups, chosen);
+  *report = candidateReport(starts, tracks, scores, groups.group, chosen);
   if (chosen < 0)
     return std::nullopt;
+  for (const int k : otherColumns(tracks, starts, groups, chosen, threshold, frame)) {
+    (*report)[k].other_column = true;
+    if (columns)
+      columns->push_back(*tracks[k]);
+  }
   return std::move(tracks[chosen]);
+}
+
+std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
+                                  double band) {
+  std::vector<char> on(pts.size(), 0);
+  if (columns.empty())
+    return on;
+  parallelFor(static_cast<int>(pts.size()), [&](int i) {
+    for (const auto& column : columns) {
+      const auto gap = surfaceGapAt(column, pts[i]);
+      if (gap && *gap <= band) {
+        on[i] = 1;
+        return;
+      }
+    }
+  });
+  return on;
 }
 
 }  // namespace modeling

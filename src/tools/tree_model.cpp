@@ -120,8 +120,11 @@ int main(int argc, char** argv) {
                   << c.start.x() << ", " << c.start.y() << ", " << c.start.z() << ") r "
                   << 1000.0 * c.start_radius << " mm: " << c.slices << " circles, z " << c.bottom
                   << ".." << c.top << ", median r " << 1000.0 * c.median_radius << " mm, score "
-                  << c.score << ", trunk " << c.group << (c.chosen ? "  <- trunk" : "") << "\n";
+                  << c.score << ", trunk " << c.group << (c.chosen ? "  <- trunk" : "")
+                  << (c.other_column ? "  <- another column" : "") << "\n";
       }
+      std::cerr << "  " << result.column_points
+                << " points on other upright columns left out of the branch search\n";
     }
     std::cout << "tree_model: " << result.model.trunk.size() << " trunk cylinders, "
               << result.model.primary_branches.size() << " primary branches in "

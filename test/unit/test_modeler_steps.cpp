@@ -374,22 +374,29 @@ TEST(TrunkSearch, ADenseColumnAwayFromTheStartsIsAStart) {
   EXPECT_TRUE(densityColumnStarts(pts, 0.1, {existing, starts[0]}, 0.03, config).empty());
 }
 
-TEST(TrunkSearch, ATrunkWhoseFootClustersLieFlatIsFoundFromItsColumn) {
-  // A trunk (r 4 cm, 1.5 m) with a whorl of branches, whose lowest cluster's fit lies on its
-  // side (as behind-the-trunk mixed pixels make it), and a post 0.5 m away whose fit stands:
-  // the trunk's column is tracked and outscores the post.
-  Points pts;
-  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.04, 1.5);
+/// A trunk (r 4 cm, 1.5 m) with a whorl of branches, whose lowest cluster's fit lies on its
+/// side (as behind-the-trunk mixed pixels make it), and a post 0.5 m away whose fit stands
+/// (cluster 1, Algorithm 2's start). `tree_points`: the trunk's and branches' count, first.
+void treeAndPost(Points* pts, std::vector<Cluster>* clusters, int* tree_points) {
+  addCylinder(*pts, {0, 0, 0}, {0, 0, 1}, 0.04, 1.5);
   for (int b = 0; b < 4; ++b) {
     const double phi = b * M_PI / 2 + 0.3;
-    addCylinder(pts, {0, 0, 0.7 + 0.15 * b}, {std::cos(phi), std::sin(phi), 0.3}, 0.012, 0.5);
+    addCylinder(*pts, {0, 0, 0.7 + 0.15 * b}, {std::cos(phi), std::sin(phi), 0.3}, 0.012, 0.5);
   }
-  const int tree_points = static_cast<int>(pts.size());
-  addCylinder(pts, {0.5, 0.3, 0}, {0, 0, 1}, 0.04, 1.5);
-  std::vector<Cluster> clusters(2);
-  clusters[0] = flatFootCluster();
-  clusters[1] = clusterOf(pts, tree_points, static_cast<int>(pts.size()));
-  clusters[1].centroid.z() = 0.1;
+  *tree_points = static_cast<int>(pts->size());
+  addCylinder(*pts, {0.5, 0.3, 0}, {0, 0, 1}, 0.04, 1.5);
+  clusters->assign(2, Cluster{});
+  (*clusters)[0] = flatFootCluster();
+  (*clusters)[1] = clusterOf(*pts, *tree_points, static_cast<int>(pts->size()));
+  (*clusters)[1].centroid.z() = 0.1;
+}
+
+TEST(TrunkSearch, ATrunkWhoseFootClustersLieFlatIsFoundFromItsColumn) {
+  // The trunk's column is tracked and outscores the post.
+  Points pts;
+  std::vector<Cluster> clusters;
+  int tree_points = 0;
+  treeAndPost(&pts, &clusters, &tree_points);
   std::vector<TrunkCandidate> report;
   const auto best = trackFromPost(pts, clusters, &report);
   ASSERT_TRUE(best);
@@ -398,6 +405,31 @@ TEST(TrunkSearch, ATrunkWhoseFootClustersLieFlatIsFoundFromItsColumn) {
   ASSERT_EQ(report.size(), 2u);
   EXPECT_TRUE(report[1].from_column);
   EXPECT_TRUE(report[1].chosen);
+}
+
+TEST(TrunkSearch, APostBesideTheTreeIsAnotherColumnAndItsPointsAreFlagged) {
+  // The post the trunk outscored is reported as another upright column; its surface, and
+  // nothing of the tree, lies on it.
+  Points pts;
+  std::vector<Cluster> clusters;
+  int tree_points = 0;
+  treeAndPost(&pts, &clusters, &tree_points);
+  TrunkPath path;
+  path.trunk = {1};
+  std::vector<TrunkCandidate> report;
+  std::vector<TrackedTrunk> columns;
+  const PointIndex index(pts);
+  ASSERT_TRUE(trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, &report, &columns));
+  ASSERT_EQ(columns.size(), 1u);
+  for (const auto& c : columns[0].centers)
+    EXPECT_LT((c.head<2>() - Eigen::Vector2d(0.5, 0.3)).norm(), 0.01) << "at z " << c.z();
+  EXPECT_GT(columns[0].centers.back().z(), 1.2);
+  const auto on = pointsOnColumns(pts, columns, 0.01);
+  EXPECT_EQ(std::count(on.begin(), on.begin() + tree_points, 1), 0);
+  const auto post_points = static_cast<double>(pts.size() - tree_points);
+  EXPECT_GT(std::count(on.begin() + tree_points, on.end(), 1), 0.9 * post_points);
+  const auto none = pointsOnColumns(pts, {}, 0.01);
+  EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
 }
 
 TEST(TrunkSearch, AColumnInASmearedFootIsTrackedAtItsOwnSize) {
@@ -445,6 +477,35 @@ TEST(TrunkSearch, AColumnInASmearedFootIsTrackedAtItsOwnSize) {
   EXPECT_LT(best->centers.back().head<2>().norm(), 0.02);
   EXPECT_GT(best->centers.back().z(), 2.2);
   EXPECT_NEAR(column->median_radius, 0.025, 0.004);
+}
+
+/// A track of circles (r 3 cm) every 5 cm from 0.1 m up to `top`, its centre `offset(z)`.
+TrackedTrunk trackAlong(double top, const std::function<Eigen::Vector2d(double)>& offset) {
+  TrackedTrunk t;
+  for (double z = 0.1; z <= top + 1e-9; z += 0.05) {
+    t.centers.emplace_back(offset(z).x(), offset(z).y(), z);
+    t.radii.push_back(0.03);
+  }
+  return t;
+}
+
+TEST(TrunkSearch, ATrackThatStoppedLowDoesNotRepresentItsTrunk) {
+  // Three tracks from one base (a steep-scaffold tree at 3 mm, seed 107): one climbs the
+  // leader to 2.7 m, one stopped at a whorl at 1.25 m, one left the leader at 0.6 m along a
+  // steep scaffold. Read over its own height the short track agreed best with both, and the
+  // trunk ended at 1.3 m (23 of 33 primaries missed). It is no voter; the leader's track is
+  // the trunk.
+  const auto leader = [](double) { return Eigen::Vector2d(0.0, 0.0); };
+  const auto scaffold = [](double z) {
+    return Eigen::Vector2d(std::max(0.0, 0.35 * (z - 0.6)), 0.0);
+  };
+  const std::vector<std::optional<TrackedTrunk>> tracks = {
+      trackAlong(2.7, leader), trackAlong(1.25, leader), trackAlong(2.35, scaffold)};
+  std::vector<int> groups;
+  EXPECT_EQ(chooseTrunkTrack(tracks, {1.0, 1.0, 1.0}, 0.1, &groups), 0);
+  EXPECT_EQ(groups, (std::vector<int>{0, 0, 0}));
+  // Without the short track the two voters stray alike; the higher one still represents.
+  EXPECT_EQ(chooseTrunkTrack({tracks[0], std::nullopt, tracks[2]}, {1.0, -1.0, 1.0}, 0.1), 0);
 }
 
 TEST(TrunkModel, ALeaderThatBendsIsSplitWhereItLeavesTheChord) {
@@ -565,6 +626,50 @@ TEST(BranchModel, KeepsABranchAndTurnsDownWireStubAndGroundClutter) {
   EXPECT_EQ(reasons["a wire"], 2);
   EXPECT_EQ(reasons["too short"], 1);
   EXPECT_EQ(reasons["too low"], 1);
+}
+
+TEST(BranchModel, PointsOnAnotherColumnAreNoCandidates) {
+  // A post (r 4.3 cm, returns spread 12 mm) 45 cm from the trunk, inside the branch search's
+  // shell, and a primary that passes it (seeds 107-108: 83 of 230 false branches lay on a
+  // post). Its flagged surface gives no candidates; the primary that passes it, whose points
+  // near the post are flagged too, is still found, as it is without the flags.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
+  const std::size_t trunk_points = pts.size();
+  addCylinder(pts, {0.03, 0, 0.8}, {1, 0.1, 0.2}, 0.01, 0.5);
+  addCylinder(pts, {-0.03, 0, 0.9}, {-1, 0.3, 1.2}, 0.01, 0.7);  // passes the post
+  const std::size_t post_begin = pts.size();
+  addCylinder(pts, {-0.45, 0.14, 0}, {0, 0, 1}, 0.043, 1.5);
+  Rng rng(11);
+  for (std::size_t k = post_begin; k < pts.size(); ++k) {
+    const Eigen::Vector2d radial = (pts[k].head<2>() - Eigen::Vector2d(-0.45, 0.14)).normalized();
+    pts[k].head<2>() += rng.normal(0.0, 0.012) * radial;
+  }
+  auto [region, config, trunk] = buildTrunk(pts, trunk_points);
+  const PointIndex index(pts);
+  TrackedTrunk post;
+  for (int k = 0; k <= 30; ++k) {
+    post.centers.emplace_back(-0.45, 0.14, 0.05 * k);
+    post.radii.push_back(0.043);
+  }
+  const auto on = pointsOnColumns(pts, {post}, 0.03);
+  const auto flagged = [&](std::size_t from, std::size_t to) {
+    return std::count(on.begin() + from, on.begin() + to, 1);
+  };
+  EXPECT_EQ(flagged(0, trunk_points), 0);
+  EXPECT_GT(flagged(post_begin, pts.size()), 0.98 * (pts.size() - post_begin));
+  const auto free = modelBranches(pts, index, trunk, region, config);
+  const auto kept = modelBranches(pts, index, trunk, region, config, nullptr, {}, on);
+  ASSERT_EQ(free.size(), 2u);
+  ASSERT_EQ(kept.size(), 2u);
+  for (std::size_t b = 0; b < 2; ++b) {
+    EXPECT_LT((kept[b].cylinder.center - free[b].cylinder.center).norm(), 0.01);
+    EXPECT_NEAR(kept[b].cylinder.radius, free[b].cylinder.radius, 0.001);
+  }
+  // Flagging a branch's own points takes it out of the search.
+  std::vector<char> primary(pts.size(), 0);
+  std::fill(primary.begin() + trunk_points, primary.begin() + post_begin, 1);
+  EXPECT_TRUE(modelBranches(pts, index, trunk, region, config, nullptr, {}, primary).empty());
 }
 
 TEST(BranchModel, AThickWireWhoseReturnsSpreadIsStillAWire) {

@@ -83,11 +83,14 @@ bool curvedPieces(const BranchFit& a, const BranchFit& b);
 /// @param rejected when given, receives every candidate turned down
 /// @param wire_directions the directions of the wires preprocessing removed (the row's): a
 /// short wire piece left in the cloud runs along them; empty: any direction
+/// @param not_branches per point of `pts` (or empty): flagged points are no candidates (the
+/// surfaces of other upright columns: pointsOnColumns)
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,
                                      std::vector<RejectedBranch>* rejected = nullptr,
-                                     const std::vector<Eigen::Vector3d>& wire_directions = {});
+                                     const std::vector<Eigen::Vector3d>& wire_directions = {},
+                                     const std::vector<char>& not_branches = {});
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling

@@ -39,6 +39,9 @@ struct ModelResult {
   std::vector<std::pair<std::string, double>> timings;  ///< stage name, seconds
   std::vector<RejectedBranch> rejected_branches;        ///< candidates turned down, and why
   std::vector<TrunkCandidate> trunk_candidates;         ///< trunk bases tracked
+  /// points on other upright columns (TrunkCandidate::other_column), left out of the branch
+  /// search
+  int column_points = 0;
 };
 
 /// @brief The configuration as the stages run it: validated, and with noise.correct_bias

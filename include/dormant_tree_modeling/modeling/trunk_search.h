@@ -23,6 +23,8 @@ struct TrunkCandidate {
   double score = -1.0;             ///< branch points around it, weighted
   int group = -1;                  ///< candidates whose tracks follow one trunk share a group
   bool chosen = false;             ///< the track that became the trunk's axis
+  /// another upright column's track (a post, a neighbour's trunk): its surface is no branch
+  bool other_column = false;
 };
 
 /// @brief Where a trunk track may begin.
@@ -56,10 +58,37 @@ std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
 /// have the most points around them between 5 and 35 cm from their axis: branches. A post has
 /// none, a neighbour's branch is no vertical cylinder.
 /// @param report filled with one entry per start
+/// @param columns if given, filled with the other upright columns the search tracked (a post,
+///        a neighbour's trunk): each other group's representative whose track stands (climbs
+///        half the clusters' height above its start) and keeps clear of the trunk's surface by
+///        more than the tracking band at every height they share
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
                                            const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config,
-                                           std::vector<TrunkCandidate>* report);
+                                           std::vector<TrunkCandidate>* report,
+                                           std::vector<TrackedTrunk>* columns = nullptr);
+
+/// @brief Which points lie on an upright column: within its track's radius plus `band` (m) of
+/// its axis, both read across the axis at the point's height (interpolated between the track's
+/// circles), at heights the track spans. Such points are no branch of the tree: a post's
+/// surface beside a tree came out as branch pieces.
+/// @return one flag per point of `pts`
+std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
+                                  double band);
+
+/// @brief The trunk among tracked candidates. Tracks whose lowest BASE_HEIGHT stand on one base
+/// are one trunk (a group); a group scores the median of its voters, the tracks that climb
+/// most of its height (a track that stopped at a whorl has a small shell), and is represented
+/// by the highest voter among those that stray alike from the others: a track that follows a
+/// scaffold strays from the leader's, and one that stopped low is no judge of either.
+/// @param tracks one per start, empty where the start gave no track
+/// @param scores one per track (trackBestTrunk's shell score), -1 where there is none
+/// @param zmin the lowest cluster centroid's z (m)
+/// @param groups if given, filled with each track's group (-1 for none)
+/// @return the chosen track's index, -1 when there is none
+int chooseTrunkTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                     const std::vector<double>& scores, double zmin,
+                     std::vector<int>* groups = nullptr);
 
 /// @brief Columns closer than this (m, horizontally) to a start are that start's trunk.
 constexpr double TRUNK_COLUMN_SEPARATION_M = 0.15;
