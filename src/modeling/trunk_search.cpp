@@ -514,6 +514,8 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
         std::find(g.group.begin(), g.group.end(), group) == g.group.end())
       continue;
     const int k = representative(tracks, g, groupVoters(tracks, g, group, frame.zmin));
+    if (k < 0)
+      continue;
     const double climb = tracks[k]->centers.back().z() - starts[k].base.z();
     if (climb >= STANDING_CLIMB * (frame.zmax - starts[k].base.z()) &&
         keepsClear(*tracks[chosen], *tracks[k], band) &&
