@@ -433,6 +433,8 @@ ModelResult TreeModeler::model(const Points& input) const {
   result.table_noise_sigma = trunk.table_sigma;
   watch.lap("trunk");
   requireScannedSurface(trunk.search_sigma);
+  // Another column's surface is taken as wide as the trunk's cylinders take theirs: the band
+  // that picks a surface out of clutter.
   const double column_band =
       std::max(config_.fit.cylinder_threshold_m, noiseBand(trunk.search_sigma));
   const std::vector<char> on_columns = pointsOnColumns(pts, columns, column_band);
