@@ -52,6 +52,14 @@ constexpr double SLICE_CENTRE_RADII = 1.0;
 // around a scaffold beside the leader reads 1.5-2.5 times it, and its residuals measure the
 // misfit, about twice the scanner's noise.
 constexpr double NOISE_TRACK_RADII = 1.5;
+// A track that ends is resumed past the pull of a whorl: its last RESUME_BACKOFF_SLICES
+// accepted circles are dropped (a whorl's branch bases pull a slice's centre aside, and the
+// track's direction with it, until the trunk's own circle lies outside its window), and the
+// climb goes on above the track's end along the line through the RESUME_LINE_SLICES circles
+// beneath them, at most MAX_RESUMES times.
+constexpr int RESUME_BACKOFF_SLICES = 2;
+constexpr int RESUME_LINE_SLICES = 6;
+constexpr int MAX_RESUMES = 3;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -623,6 +631,53 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
     out.radii.push_back(circle->radius);
   }
   return out;
+}
+
+namespace {
+
+/// The track resumed past its last RESUME_BACKOFF_SLICES circles along the line beneath them,
+/// when that climbs more than a slice beyond its end; nothing otherwise.
+std::optional<TrackedTrunk> resumePastPull(const Points& pts, const PointIndex& index,
+                                           const TrackedTrunk& track, double threshold,
+                                           const ModelerConfig& config) {
+  const std::size_t n = track.centers.size();
+  if (n < static_cast<std::size_t>(RESUME_BACKOFF_SLICES + RESUME_LINE_SLICES))
+    return std::nullopt;
+  const std::size_t kept = n - RESUME_BACKOFF_SLICES;
+  const Points below(track.centers.begin() + (kept - RESUME_LINE_SLICES),
+                     track.centers.begin() + kept);
+  Eigen::Vector3d mean;
+  Eigen::Vector3d axis = principalAxis(below, &mean);
+  if (axis.dot(below.back() - below.front()) < 0.0)
+    axis = -axis;
+  // From the line's point level with the track's end: the pulled slices are not fitted again.
+  const Eigen::Vector3d from = mean + (track.centers.back() - mean).dot(axis) * axis;
+  const double radius = median(std::vector<double>(
+      track.radii.begin() + (kept - RESUME_LINE_SLICES), track.radii.begin() + kept));
+  TrackedTrunk more =
+      trackTrunk(pts, index, from, axis, radius, threshold, config, TRACK_MAX_MISSES, true);
+  if (more.centers.empty() ||
+      (more.centers.back() - track.centers.back()).dot(axis) <= config.trunk.slice_height_m)
+    return std::nullopt;
+  TrackedTrunk joined;
+  joined.centers.assign(track.centers.begin(), track.centers.begin() + kept);
+  joined.radii.assign(track.radii.begin(), track.radii.begin() + kept);
+  joined.centers.insert(joined.centers.end(), more.centers.begin(), more.centers.end());
+  joined.radii.insert(joined.radii.end(), more.radii.begin(), more.radii.end());
+  return joined;
+}
+
+}  // namespace
+
+TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
+                              double threshold, const ModelerConfig& config) {
+  for (int k = 0; k < MAX_RESUMES; ++k) {
+    auto resumed = resumePastPull(pts, index, track, threshold, config);
+    if (!resumed)
+      break;
+    track = std::move(*resumed);
+  }
+  return track;
 }
 
 double estimateNoiseSigma(const Points& pts, const Centerline& line,

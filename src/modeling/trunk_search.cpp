@@ -488,6 +488,21 @@ void trackStarts(const Points& pts, const PointIndex& index, const std::vector<T
   });
 }
 
+/// Every track resumed past a whorl that ended it (resumePastWhorls), and scored again. Only
+/// after the density columns are chosen, on what stood before: a track around a young trunk's
+/// smear of mixed pixels (a circle of 12 cm radius) ends low and leaves the trunk to its
+/// column; resumed, it climbs to the top.
+void resumeTracks(const Points& pts, const PointIndex& index, const std::vector<TrunkStart>& starts,
+                  double threshold, const SearchFrame& frame, const ModelerConfig& config,
+                  std::vector<std::optional<TrackedTrunk>>* tracks, std::vector<double>* scores) {
+  parallelFor(static_cast<int>(starts.size()), [&](int k) {
+    if (!(*tracks)[k])
+      return;
+    (*tracks)[k] = resumePastWhorls(pts, index, std::move(*(*tracks)[k]), threshold, config);
+    (*scores)[k] = trackScore(index, *(*tracks)[k], starts[k], frame);
+  });
+}
+
 /// The starts whose tracks climb at least half of the clouds' height above them: what stands
 /// near one is its trunk. A start whose track stopped low (on a wide clutter arc by a trunk's
 /// foot) explains no column.
@@ -559,6 +574,7 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     starts.insert(starts.end(), columns.begin(), columns.end());
     trackStarts(pts, index, starts, from, threshold, frame, config, &tracks, &scores);
   }
+  resumeTracks(pts, index, starts, threshold, frame, config, &tracks, &scores);
   const TrackGroups groups = groupTracks(tracks);
   const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);

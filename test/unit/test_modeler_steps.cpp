@@ -332,6 +332,61 @@ TEST(TrunkTracking, AtANoisyWhorlTheTrackStaysOnTheLeader) {
   EXPECT_LT(worst, 0.03);
 }
 
+TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
+  // A young trunk (r 33 mm, up to 2.5 m) with 12 mm radial noise and a whorl of three branches
+  // (r 15 mm) leaving it at 0.6 m to one side: their bases pull the slice centres aside, and
+  // the track's direction with them, until the trunk's own circle lies outside the window. The
+  // track ends there; resumed, it must go on up the trunk.
+  Points pts;
+  Rng rng(11);
+  const double sigma = 0.012;
+  const auto ring = [&](const Eigen::Vector3d& base, const Eigen::Vector3d& axis, double r,
+                        double length, int n) {
+    const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
+    for (int i = 0; i < n; ++i) {
+      const double t = rng.uniform(0.0, length), phi = rng.uniform(0.0, 2.0 * M_PI);
+      pts.push_back(base + t * a +
+                    (r + rng.normal(0.0, sigma)) * (std::cos(phi) * u + std::sin(phi) * v));
+    }
+  };
+  ring({0, 0, 0}, {0, 0, 1}, 0.033, 2.5, 35000);
+  for (const double azimuth : {-0.5, 0.0, 0.5})
+    ring({0, 0, 0.58}, {std::cos(azimuth), std::sin(azimuth), 0.5}, 0.015, 0.5, 6000);
+  const PointIndex index(pts);
+  ModelerConfig config;
+  const TrackedTrunk track =
+      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, 0.033, 2.5 * sigma, config);
+  ASSERT_FALSE(track.centers.empty());
+  const TrackedTrunk resumed = resumePastWhorls(pts, index, track, 2.5 * sigma, config);
+  std::printf("[ INFO ] track top %.2f m, resumed %.2f m\n", track.centers.back().z(),
+              resumed.centers.back().z());
+  EXPECT_LT(track.centers.back().z(), 1.0);
+  EXPECT_GT(resumed.centers.back().z(), 2.3);
+  for (const auto& c : resumed.centers) {
+    if (c.z() > 0.8)
+      EXPECT_LT(c.head<2>().norm(), 0.015) << "at " << c.z() << " m";
+  }
+}
+
+TEST(TrunkTracking, ATrackThatEndsAtTheTrunksTopIsNotResumed) {
+  Points pts;
+  Rng rng(12);
+  for (int i = 0; i < 20000; ++i) {
+    const double z = rng.uniform(0.0, 1.5), phi = rng.uniform(0.0, 2.0 * M_PI);
+    const double r = 0.03 + rng.normal(0.0, 0.006);
+    pts.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  const PointIndex index(pts);
+  ModelerConfig config;
+  const TrackedTrunk track =
+      trackTrunk(pts, index, {0, 0, 0.05}, {0, 0, 1}, 0.03, 2.5 * 0.006, config);
+  const TrackedTrunk resumed = resumePastWhorls(pts, index, track, 2.5 * 0.006, config);
+  ASSERT_GE(track.centers.size(), 20u);
+  ASSERT_EQ(resumed.centers.size(), track.centers.size());
+  for (std::size_t k = 0; k < track.centers.size(); ++k)
+    EXPECT_EQ(resumed.centers[k], track.centers[k]) << "slice " << k;
+}
+
 /// A trunk's foot cluster whose cylinder fit lies on its side, as mixed pixels behind the
 /// trunk make it.
 Cluster flatFootCluster() {

@@ -130,6 +130,9 @@ double estimateNoiseSigma(const Points& pts, const Centerline& line,
 std::vector<double> disturbancePartitions(const std::vector<Slice>& slices, double slice_height,
                                           int zero_run, double top);
 
+/// @brief Slices in a row without an acceptable circle that end a track.
+constexpr int TRACK_MAX_MISSES = 4;
+
 /// @brief Result of trackTrunk().
 struct TrackedTrunk {
   std::vector<Eigen::Vector3d> centers;  ///< accepted slice centres, bottom to top
@@ -146,7 +149,19 @@ struct TrackedTrunk {
 ///        any trunk radius: the retry for a start whose free first circle took in clutter
 TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& direction, double radius, double threshold,
-                        const ModelerConfig& config, int max_misses = 4, bool trust_radius = false);
+                        const ModelerConfig& config, int max_misses = TRACK_MAX_MISSES,
+                        bool trust_radius = false);
+
+/// @brief A track (bottom to top) resumed past where a whorl ended it: a whorl's branch bases
+/// pull a slice's centre aside, and the track's direction with it, until the trunk's own circle
+/// above lies outside the window. The last two circles are dropped and trackTrunk() goes on
+/// above the track's end along the line through the six beneath them (their median radius
+/// trusted); kept when it climbs more than a slice further, up to three times.
+/// @param track as trackTrunk() returned it, ordered bottom to top
+/// @param threshold the circle band (m), as given to trackTrunk()
+/// @return the resumed track, or `track` itself when nothing climbs further
+TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
+                              double threshold, const ModelerConfig& config);
 
 /// @brief The trunk's neighbourhood reaches this many radii from its axis ...
 constexpr double TRUNK_REACH_RADII = 3.0;
