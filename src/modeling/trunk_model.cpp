@@ -58,6 +58,9 @@ constexpr double NOISE_TRACK_RADII = 1.5;
 // climb goes on above the track's end along the line through the RESUME_LINE_SLICES circles
 // beneath them, at most MAX_RESUMES times.
 constexpr int RESUME_BACKOFF_SLICES = 2;
+// Only a pull is resumed: the track's last circle lies more than this share of the radius off
+// the line (a track that ran out of trunk, into a crown of thin forks, ends on its line).
+constexpr double RESUME_PULL_RADII = 0.5;
 constexpr int RESUME_LINE_SLICES = 6;
 constexpr int MAX_RESUMES = 3;
 
@@ -654,6 +657,8 @@ std::optional<TrackedTrunk> resumePastPull(const Points& pts, const PointIndex& 
   const Eigen::Vector3d from = mean + (track.centers.back() - mean).dot(axis) * axis;
   const double radius = median(std::vector<double>(
       track.radii.begin() + (kept - RESUME_LINE_SLICES), track.radii.begin() + kept));
+  if ((track.centers.back() - from).norm() <= RESUME_PULL_RADII * radius)
+    return std::nullopt;
   TrackedTrunk more =
       trackTrunk(pts, index, from, axis, radius, threshold, config, TRACK_MAX_MISSES, true);
   if (more.centers.empty() ||

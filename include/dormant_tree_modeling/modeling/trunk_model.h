@@ -154,9 +154,10 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 
 /// @brief A track (bottom to top) resumed past where a whorl ended it: a whorl's branch bases
 /// pull a slice's centre aside, and the track's direction with it, until the trunk's own circle
-/// above lies outside the window. The last two circles are dropped and trackTrunk() goes on
-/// above the track's end along the line through the six beneath them (their median radius
-/// trusted); kept when it climbs more than a slice further, up to three times.
+/// above lies outside the window. When the last circle lies more than half the radius off the
+/// line through the six circles beneath the last two, those two are dropped and trackTrunk()
+/// goes on above the track's end along that line (their median radius trusted); kept when it
+/// climbs more than a slice further, up to three times.
 /// @param track as trackTrunk() returned it, ordered bottom to top
 /// @param threshold the circle band (m), as given to trackTrunk()
 /// @return the resumed track, or `track` itself when nothing climbs further
