@@ -300,6 +300,18 @@ TEST(TrunkTracking, AStartOnTheFlankWithASmallGuessFindsTheWholeTrunk) {
   }
 }
 
+/// n points on a tube of radius r along `axis` from `base`, `length` m long, seen all around,
+/// with radial noise of `sigma` m.
+void addNoisyTube(Points& pts, Rng& rng, const Eigen::Vector3d& base, const Eigen::Vector3d& axis,
+                  double r, double length, int n, double sigma) {
+  const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
+  for (int i = 0; i < n; ++i) {
+    const double t = rng.uniform(0.0, length), phi = rng.uniform(0.0, 2.0 * M_PI);
+    pts.push_back(base + t * a +
+                  (r + rng.normal(0.0, sigma)) * (std::cos(phi) * u + std::sin(phi) * v));
+  }
+}
+
 TEST(TrunkTracking, AtANoisyWhorlTheTrackStaysOnTheLeader) {
   // A leader (r 45 mm) and a scaffold (r 33 mm) leaving it at 1 m at 40 degrees, both seen
   // all around with 12 mm radial noise: across the fork the slices are one blob whose trimmed
@@ -307,17 +319,8 @@ TEST(TrunkTracking, AtANoisyWhorlTheTrackStaysOnTheLeader) {
   Points pts;
   Rng rng(7);
   const double sigma = 0.012;
-  const auto ring = [&](const Eigen::Vector3d& base, const Eigen::Vector3d& axis, double r,
-                        double length, int n) {
-    const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
-    for (int i = 0; i < n; ++i) {
-      const double t = rng.uniform(0.0, length), phi = rng.uniform(0.0, 2.0 * M_PI);
-      pts.push_back(base + t * a +
-                    (r + rng.normal(0.0, sigma)) * (std::cos(phi) * u + std::sin(phi) * v));
-    }
-  };
-  ring({0, 0, 0}, {0, 0, 1}, 0.045, 2.0, 40000);
-  ring({0, 0, 1.0}, {std::sin(0.7), 0, std::cos(0.7)}, 0.033, 0.8, 16000);
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.045, 2.0, 40000, sigma);
+  addNoisyTube(pts, rng, {0, 0, 1.0}, {std::sin(0.7), 0, std::cos(0.7)}, 0.033, 0.8, 16000, sigma);
   const PointIndex index(pts);
   ModelerConfig config;
   const TrackedTrunk track =
@@ -340,18 +343,10 @@ TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
   Points pts;
   Rng rng(11);
   const double sigma = 0.012;
-  const auto ring = [&](const Eigen::Vector3d& base, const Eigen::Vector3d& axis, double r,
-                        double length, int n) {
-    const Eigen::Vector3d a = axis.normalized(), u = a.unitOrthogonal(), v = a.cross(u);
-    for (int i = 0; i < n; ++i) {
-      const double t = rng.uniform(0.0, length), phi = rng.uniform(0.0, 2.0 * M_PI);
-      pts.push_back(base + t * a +
-                    (r + rng.normal(0.0, sigma)) * (std::cos(phi) * u + std::sin(phi) * v));
-    }
-  };
-  ring({0, 0, 0}, {0, 0, 1}, 0.033, 2.5, 35000);
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.033, 2.5, 35000, sigma);
   for (const double azimuth : {-0.5, 0.0, 0.5})
-    ring({0, 0, 0.58}, {std::cos(azimuth), std::sin(azimuth), 0.5}, 0.015, 0.5, 6000);
+    addNoisyTube(pts, rng, {0, 0, 0.58}, {std::cos(azimuth), std::sin(azimuth), 0.5}, 0.015, 0.5,
+                 6000, sigma);
   const PointIndex index(pts);
   ModelerConfig config;
   const TrackedTrunk track =
