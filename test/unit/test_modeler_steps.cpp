@@ -366,11 +366,7 @@ TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
 TEST(TrunkTracking, ATrackThatEndsAtTheTrunksTopIsNotResumed) {
   Points pts;
   Rng rng(12);
-  for (int i = 0; i < 20000; ++i) {
-    const double z = rng.uniform(0.0, 1.5), phi = rng.uniform(0.0, 2.0 * M_PI);
-    const double r = 0.03 + rng.normal(0.0, 0.006);
-    pts.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
-  }
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5, 20000, 0.006);
   const PointIndex index(pts);
   ModelerConfig config;
   const TrackedTrunk track =
