@@ -113,6 +113,13 @@ double trackingThreshold(const Points& pts, const std::vector<Cluster>& clusters
   return std::max(0.5 * config.fit.circle_threshold_m, noiseBand(median(guesses)));
 }
 
+/// Whether a track stands on its start's trunk: it climbs at least STANDING_CLIMB of the
+/// clusters' height above the start (`zmax`: the highest cluster centroid's z, m).
+bool stands(const TrackedTrunk& t, const TrunkStart& start, double zmax) {
+  const double climb = t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
+  return climb >= STANDING_CLIMB * (zmax - start.base.z());
+}
+
 /// Up from the start, retried from a trusted radius when the free first circle stopped it low,
 /// then down to the ground.
 TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkStart& start,
@@ -125,7 +132,7 @@ TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkSt
     return t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
   };
   const auto retry = [&](double radius) {
-    if (climb(tracked) >= STANDING_CLIMB * (zmax - start.base.z()))
+    if (stands(tracked, start, zmax))
       return;
     TrackedTrunk again =
         trackTrunk(pts, index, start.base, up, radius, threshold, config, RETRY_MISSES, true);
@@ -469,32 +476,30 @@ std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
 
 namespace {
 
-/// Tracks and scores of starts[from..]: independent, on all cores.
+/// Tracks of starts[from..]: independent, on all cores.
 void trackStarts(const Points& pts, const PointIndex& index, const std::vector<TrunkStart>& starts,
                  std::size_t from, double threshold, const SearchFrame& frame,
-                 const ModelerConfig& config, std::vector<std::optional<TrackedTrunk>>* tracks,
-                 std::vector<double>* scores) {
+                 const ModelerConfig& config, std::vector<std::optional<TrackedTrunk>>* tracks) {
   tracks->resize(starts.size());
-  scores->resize(starts.size(), -1.0);
   parallelFor(static_cast<int>(starts.size() - from), [&](int i) {
     const std::size_t k = from + i;
     if (!starts[k].usable)
       return;
     TrackedTrunk tracked = climbFrom(pts, index, starts[k], threshold, frame.zmax, config);
-    if (tracked.centers.size() < 3)
-      return;
-    (*scores)[k] = trackScore(index, tracked, starts[k], frame);
-    (*tracks)[k] = std::move(tracked);
+    if (tracked.centers.size() >= 3)
+      (*tracks)[k] = std::move(tracked);
   });
 }
 
-/// Every track resumed past a whorl that ended it (resumePastWhorls), and scored again. Only
-/// after the density columns are chosen, on what stood before: a track around a young trunk's
-/// smear of mixed pixels (a circle of 12 cm radius) ends low and leaves the trunk to its
-/// column; resumed, it climbs to the top.
-void resumeTracks(const Points& pts, const PointIndex& index, const std::vector<TrunkStart>& starts,
-                  double threshold, const SearchFrame& frame, const ModelerConfig& config,
-                  std::vector<std::optional<TrackedTrunk>>* tracks, std::vector<double>* scores) {
+/// Every track resumed past a whorl that ended it (resumePastWhorls), then scored (-1 where
+/// there is no track). Only after the density columns are chosen, on what stood before: a
+/// track around a young trunk's smear of mixed pixels (a circle of 12 cm radius) ends low and
+/// leaves the trunk to its column; resumed, it climbs to the top.
+void resumeAndScore(const Points& pts, const PointIndex& index,
+                    const std::vector<TrunkStart>& starts, double threshold,
+                    const SearchFrame& frame, const ModelerConfig& config,
+                    std::vector<std::optional<TrackedTrunk>>* tracks, std::vector<double>* scores) {
+  scores->assign(starts.size(), -1.0);
   parallelFor(static_cast<int>(starts.size()), [&](int k) {
     if (!(*tracks)[k])
       return;
@@ -511,8 +516,7 @@ std::vector<TrunkStart> standingStarts(const std::vector<TrunkStart>& starts,
                                        const SearchFrame& frame) {
   std::vector<TrunkStart> out;
   for (std::size_t k = 0; k < starts.size(); ++k) {
-    if (tracks[k] && tracks[k]->centers.back().z() - starts[k].base.z() >=
-                         STANDING_CLIMB * (frame.zmax - starts[k].base.z()))
+    if (tracks[k] && stands(*tracks[k], starts[k], frame.zmax))
       out.push_back(starts[k]);
   }
   return out;
@@ -531,8 +535,7 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
     const int k = representative(tracks, g, groupVoters(tracks, g, group, frame.zmin));
     if (k < 0)
       continue;
-    const double climb = tracks[k]->centers.back().z() - starts[k].base.z();
-    if (climb >= STANDING_CLIMB * (frame.zmax - starts[k].base.z()) &&
+    if (stands(*tracks[k], starts[k], frame.zmax) &&
         keepsClear(*tracks[chosen], *tracks[k], band) &&
         keepsClear(*tracks[k], *tracks[chosen], band))
       out.push_back(k);
@@ -560,7 +563,7 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   const double threshold = trackingThreshold(pts, clusters, starts, config);
   std::vector<std::optional<TrackedTrunk>> tracks;
   std::vector<double> scores;
-  trackStarts(pts, index, starts, 0, threshold, frame, config, &tracks, &scores);
+  trackStarts(pts, index, starts, 0, threshold, frame, config, &tracks);
   // Then the dense columns that no standing track explains, in the same start order.
   std::vector<double> radii;
   for (const auto& s : starts) {
@@ -572,9 +575,9 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     const auto columns = densityColumnStarts(pts, frame.zmin, standingStarts(starts, tracks, frame),
                                              median(radii), config);
     starts.insert(starts.end(), columns.begin(), columns.end());
-    trackStarts(pts, index, starts, from, threshold, frame, config, &tracks, &scores);
+    trackStarts(pts, index, starts, from, threshold, frame, config, &tracks);
   }
-  resumeTracks(pts, index, starts, threshold, frame, config, &tracks, &scores);
+  resumeAndScore(pts, index, starts, threshold, frame, config, &tracks, &scores);
   const TrackGroups groups = groupTracks(tracks);
   const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);
