@@ -263,14 +263,20 @@ constexpr int MIN_THIN_POINTS = 6;
 constexpr double MIN_THIN_RADIUS_M = 0.002;
 // Robust re-centring works on slices of this length (m) along the axis.
 constexpr double THIN_SLICE_M = 0.04;
-// A parabola through the slice centroids needs three; a fourth keeps it from passing through
-// every centroid's own scatter.
+// A parabola through the slice centres needs three; a fourth keeps it from passing through
+// every centre's own scatter.
 constexpr std::size_t MIN_BENT_SLICES = 4;
 // A branch this many noise sigmas thick shows its arc: its centre comes from a circle fit to
 // its cross-sections, which a one-sided view does not pull, if that circle's radius is within
 // this factor of the moment's.
 constexpr double ARC_MIN_SIGMAS = 2.0;
 constexpr double ARC_RADIUS_SHARE = 2.0;
+// A circle through one slice's points wants more of them than a centroid does.
+constexpr int MIN_ARC_POINTS = 2 * MIN_THIN_POINTS;
+// With at least this many slices the axis leaves out the first and the last: they are cut
+// across by what bounds the part (the trunk's bark at a branch's base, the part's far end),
+// so their centres are the least sure and, at the ends of the line, weigh the most.
+constexpr std::size_t MIN_SLICES_WITHOUT_ENDS = 5;
 // A raw radius is this quantile of the slices' moments, taper taken out: shoots and spurs on a
 // branch add to the moments of the slices they cross and never take from any, so a median
 // reads a branch with shoots thicker than the rig's bare rods it is calibrated on. The tables
@@ -280,6 +286,26 @@ constexpr double SLICE_MOMENT_QUANTILE = 0.3;
 constexpr std::size_t MIN_TAPER_SLICES = 4;
 // Rounds of re-centring and re-measuring a thin cylinder's points.
 constexpr int THIN_FIT_ROUNDS = 5;
+
+/// Whether a circle fitted to a branch's cross-sections is its surface: a radius within
+/// ARC_RADIUS_SHARE of the moment's `radius` and a centre within that radius of where it was
+/// sought.
+bool plausibleArc(const std::optional<Circle>& circle, double radius) {
+  return circle && circle->radius > radius / ARC_RADIUS_SHARE &&
+         circle->radius < radius * ARC_RADIUS_SHARE && circle->center.norm() < radius;
+}
+
+/// Where one slice's cross-section is centred, as an offset from its centroid: `section` holds
+/// its points across the axis, about that centroid. A centroid lies on whatever part of the
+/// section was seen or kept (the side facing the scanner, the near side the reach left, bark
+/// at a branch's base); a branch thick enough to show its arc (arc_radius > 0) is centred on
+/// the circle its points lie on when that circle is plausible.
+Eigen::Vector2d arcOffset(const Points2& section, double arc_radius) {
+  if (arc_radius <= 0.0 || static_cast<int>(section.size()) < MIN_ARC_POINTS)
+    return Eigen::Vector2d::Zero();
+  const auto circle = fitCircle(section);
+  return plausibleArc(circle, arc_radius) ? circle->center : Eigen::Vector2d::Zero();
+}
 
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
@@ -337,28 +363,46 @@ long thinSlice(const Cylinder& cyl, const Eigen::Vector3d& p) {
   return static_cast<long>(std::floor((p - cyl.center).dot(cyl.axis) / THIN_SLICE_M));
 }
 
+/// The centre of one slice's points (`slice` indexes pts; u and v span the plane across the
+/// axis): their centroid, moved onto their arc (arcOffset).
+Eigen::Vector3d sliceCentre(const Points& pts, const std::vector<int>& slice,
+                            const Eigen::Vector3d& u, const Eigen::Vector3d& v, double arc_radius) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const int i : slice)
+    centroid += pts[i];
+  centroid /= static_cast<double>(slice.size());
+  Points2 section;
+  for (const int i : slice)
+    section.emplace_back((pts[i] - centroid).dot(u), (pts[i] - centroid).dot(v));
+  const Eigen::Vector2d off = arcOffset(section, arc_radius);
+  return centroid + off.x() * u + off.y() * v;
+}
+
 /// The points of `best` within `reach` of the axis (empty below MIN_THIN_POINTS), and the axis
-/// moved onto the line through their slices' centroids (a full cross-section's centroid is its
-/// centre) when that stays within 30 degrees.
+/// moved onto the line through their slices' centres (sliceCentre; a full cross-section's
+/// centroid is its centre) when that stays within 30 degrees.
 std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
-                          const Eigen::Vector3d& axis_guess, double reach, Cylinder* cyl) {
+                          const Eigen::Vector3d& axis_guess, double reach, double arc_radius,
+                          Cylinder* cyl) {
   std::vector<int> used;
-  std::map<long, std::pair<Eigen::Vector3d, int>> centroids;
+  std::map<long, std::vector<int>> slices;
   for (const int i : best) {
     if (axisDistance(*cyl, pts[i]) >= reach)
       continue;
     used.push_back(i);
-    auto it = centroids.try_emplace(thinSlice(*cyl, pts[i]), Eigen::Vector3d::Zero(), 0).first;
-    it->second.first += pts[i];
-    ++it->second.second;
+    slices[thinSlice(*cyl, pts[i])].push_back(i);
   }
   if (used.size() < MIN_THIN_POINTS)
     return {};
+  Eigen::Vector3d u, v;
+  basis(cyl->axis, u, v);
   Points centres;
-  for (const auto& kv : centroids) {
-    if (kv.second.second >= 3)
-      centres.push_back(kv.second.first / kv.second.second);
+  for (const auto& kv : slices) {
+    if (kv.second.size() >= 3)
+      centres.push_back(sliceCentre(pts, kv.second, u, v, arc_radius));
   }
+  if (centres.size() >= MIN_SLICES_WITHOUT_ENDS)
+    centres = Points(centres.begin() + 1, centres.end() - 1);
   if (centres.size() >= 2) {
     Eigen::Vector3d c;
     Eigen::Vector3d d = principalAxis(centres, &c);
@@ -373,25 +417,23 @@ std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
 }
 
 /// A branch's axis as a parabola along the fitted line: the offset across it as a quadratic
-/// in the position along it, fitted to the slices' centroids. A branch bends by a few degrees
-/// per slice; over a fit's length the straight line leaves its centre by millimetres, which a
-/// radius from second moments would take for thickness.
+/// in the position along it, fitted to the slices' centres (sliceCentre). A branch bends by a few
+/// degrees per slice; over a fit's length the straight line leaves its centre by millimetres, which
+/// a radius from second moments would take for thickness.
 class BentAxis {
  public:
-  BentAxis(const Points& pts, const std::vector<int>& used, const Cylinder& cyl)
+  BentAxis(const Points& pts, const std::vector<int>& used, const Cylinder& cyl, double arc_radius)
       : centre_(cyl.center), axis_(cyl.axis) {
     basis(axis_, u_, v_);
-    std::map<long, std::pair<Eigen::Vector3d, int>> sums;
-    for (const int i : used) {
-      const Eigen::Vector3d w = pts[i] - centre_;
-      auto it = sums.try_emplace(thinSlice(cyl, pts[i]), Eigen::Vector3d::Zero(), 0).first;
-      it->second.first += Eigen::Vector3d(w.dot(axis_), w.dot(u_), w.dot(v_));
-      ++it->second.second;
-    }
+    std::map<long, std::vector<int>> slices;
+    for (const int i : used)
+      slices[thinSlice(cyl, pts[i])].push_back(i);
     std::vector<Eigen::Vector3d> centres;
-    for (const auto& kv : sums) {
-      if (kv.second.second >= MIN_THIN_POINTS)
-        centres.push_back(kv.second.first / kv.second.second);
+    for (const auto& kv : slices) {
+      if (static_cast<int>(kv.second.size()) < MIN_THIN_POINTS)
+        continue;
+      const Eigen::Vector3d w = sliceCentre(pts, kv.second, u_, v_, arc_radius) - centre_;
+      centres.emplace_back(w.dot(axis_), w.dot(u_), w.dot(v_));
     }
     if (centres.size() < MIN_BENT_SLICES)
       return;
@@ -415,8 +457,7 @@ class BentAxis {
     for (const int i : used)
       section.push_back(across(pts[i]));
     const auto circle = fitCircle(section);
-    if (circle && circle->radius > radius / ARC_RADIUS_SHARE &&
-        circle->radius < radius * ARC_RADIUS_SHARE && circle->center.norm() < radius)
+    if (plausibleArc(circle, radius))
       shift_ = circle->center;
   }
 
@@ -556,9 +597,9 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   const std::vector<int> best = thinAxis(pts, axis_guess, band, seed, &cyl);
   if (best.size() < MIN_THIN_POINTS)
     return std::nullopt;
-  // Robust re-centring: per slice the centroid of the points within radius + 2.5 sigma of the
-  // current axis, a line through the slice centroids, the radius from the slices' second
-  // moments about the axis bent through those centroids (sliceMoments), less the scatter. A
+  // Robust re-centring: per slice the centre of the points within radius + 2.5 sigma of the
+  // current axis (sliceCentre), a line through those centres, the radius from the slices'
+  // second moments about the axis bent through them (sliceMoments), less the scatter. A
   // parallel shoot or a spur moves a least-squares cylinder, not this. The points and the
   // centre follow the moments' spread, as the shoots belong to the branch taken out.
   std::vector<int> used;
@@ -574,14 +615,16 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
   for (int round = 0; round < THIN_FIT_ROUNDS; ++round) {
     // The moment must see the whole scatter it then subtracts.
     const double reach = radius + noiseBand(std::max(sigma, scatter)) + 0.002;
-    used = recentre(pts, best, axis_guess, reach, &cyl);
-    if (used.empty())
-      return std::nullopt;
-    BentAxis bent(pts, used, cyl);
-    // A raw radius still carries the noise.
+    // A raw radius still carries the noise. The first round's radius is only the bound.
     const double noiseless =
         raw ? std::sqrt(std::max(0.0, radius * radius - sigma * sigma)) : radius;
-    if (round > 0 && noiseless >= ARC_MIN_SIGMAS * std::max(sigma, scatter))
+    const bool arc = round > 0 && noiseless >= ARC_MIN_SIGMAS * std::max(sigma, scatter);
+    const double arc_radius = arc ? radius : 0.0;
+    used = recentre(pts, best, axis_guess, reach, arc_radius, &cyl);
+    if (used.empty())
+      return std::nullopt;
+    BentAxis bent(pts, used, cyl, arc_radius);
+    if (arc)
       bent.centreOnArc(pts, used, radius);
     const auto slices = sliceMoments(pts, used, cyl, bent, reach, raw);
     if (!slices)

@@ -289,6 +289,33 @@ TEST(Cylinder, ThinRawRadiusIsTheTaperAtTheMiddle) {
   EXPECT_NEAR(tapered->radius, rod->radius, 0.00015);
 }
 
+TEST(Cylinder, ThickTaperedScaffoldAtTheTrunkKeepsItsAxis) {
+  // A scaffold tapering from 31 to 18 mm over 44 cm, under 3 mm noise, cut obliquely at its
+  // far end, with the trunk's bark (70 mm) around its base and an axis guess 6 degrees off: as
+  // a near part reaches the branch search. Slice centroids at both ends lie off the axis
+  // (bark at the base, half a section at the cut); a line through them is tilted, the reach
+  // then cuts each end's far side and the radius shrinks round by round. It reads as the
+  // same branch alone and without the cut.
+  const double length = 0.44, sigma = 0.003;
+  const Points alone = taperedRodPoints(0.031, 0.018, length, 5000, sigma, 23);
+  Points near;
+  for (const auto& p : alone) {
+    if (p.x() + 0.6 * p.y() < length - 0.03)
+      near.push_back(p);
+  }
+  const Points trunk =
+      cylinderPoints({-0.065, 0.0, -0.12}, Eigen::Vector3d::UnitZ(), 0.07, 0.24, 6000, sigma, 24);
+  for (const auto& p : trunk) {
+    if (p.x() > -0.02 && std::hypot(p.y(), p.z()) < 0.1)
+      near.push_back(p);
+  }
+  const auto clean = fitThinCylinder(alone, Eigen::Vector3d::UnitX(), sigma, 0.0, 0.07, 1);
+  const auto fit = fitThinCylinder(near, Eigen::Vector3d(1.0, 0.15, 0.0), sigma, 0.0, 0.07, 1);
+  ASSERT_TRUE(clean && fit);
+  EXPECT_NEAR(fit->radius, clean->radius, 0.001);
+  EXPECT_GT(fit->axis.x(), std::cos(2.0 * M_PI / 180.0));
+}
+
 TEST(Cylinder, ThickRadiusFromOneSide) {
   // A 14 mm scaffold under 3 mm noise seen all around, and only from one side (the leader
   // hides the other): the same raw radius, where a moment about the slices' centroids reads
