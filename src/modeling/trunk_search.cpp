@@ -43,7 +43,8 @@ constexpr int COLUMN_HALF_CELLS = 2;
 constexpr int COLUMN_STARTS = 3;
 // A start whose track climbs this share of the clusters' height above it stands on a trunk.
 constexpr double STANDING_CLIMB = 0.5;
-constexpr int RETRY_MISSES = 4;  // a retry's run of missed slices that ends it
+constexpr int RETRY_MISSES = 4;               // a retry's run of missed slices that ends it
+constexpr std::size_t MIN_TRACK_CIRCLES = 3;  // fewer circles are no track
 // A column's retries trust each of these radii (m): with the trusted first circle's 0.6x..1.6x
 // they cover 12..128 mm, young to mature apple trunks.
 constexpr std::array<double, 3> COLUMN_RETRY_RADII_M = {0.02, 0.04, 0.08};
@@ -161,19 +162,55 @@ TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkSt
   return tracked;
 }
 
-/// How far p lies outside a track's surface, read across its axis at p's height (centre and
-/// radius interpolated between the circles around it); nothing outside the track's span.
-std::optional<double> surfaceGapAt(const TrackedTrunk& t, const Eigen::Vector3d& p) {
+/// A track's cross-section at height z: its axis (x, y) and radius, interpolated between the
+/// circles around z; nothing outside the track's span.
+struct TrackSection {
+  Eigen::Vector2d axis;
+  double radius;
+};
+std::optional<TrackSection> sectionAt(const TrackedTrunk& t, double z) {
   const auto& c = t.centers;
-  if (c.size() < 2 || p.z() < c.front().z() || p.z() > c.back().z())
+  if (c.size() < 2 || z < c.front().z() || z > c.back().z())
     return std::nullopt;
-  const auto above = std::upper_bound(c.begin() + 1, c.end() - 1, p.z(),
-                                      [](double z, const Eigen::Vector3d& q) { return z < q.z(); });
+  const auto above = std::upper_bound(c.begin() + 1, c.end() - 1, z,
+                                      [](double h, const Eigen::Vector3d& q) { return h < q.z(); });
   const std::size_t i = above - c.begin();
   const double dz = c[i].z() - c[i - 1].z();
-  const double f = dz > 1e-9 ? std::clamp((p.z() - c[i - 1].z()) / dz, 0.0, 1.0) : 0.0;
-  const Eigen::Vector2d axis = c[i - 1].head<2>() + f * (c[i].head<2>() - c[i - 1].head<2>());
-  return (p.head<2>() - axis).norm() - (t.radii[i - 1] + f * (t.radii[i] - t.radii[i - 1]));
+  const double f = dz > 1e-9 ? std::clamp((z - c[i - 1].z()) / dz, 0.0, 1.0) : 0.0;
+  return TrackSection{c[i - 1].head<2>() + f * (c[i].head<2>() - c[i - 1].head<2>()),
+                      t.radii[i - 1] + f * (t.radii[i] - t.radii[i - 1])};
+}
+
+/// How far p lies outside a track's surface, read across its axis at p's height; nothing
+/// outside the track's span.
+std::optional<double> surfaceGapAt(const TrackedTrunk& t, const Eigen::Vector3d& p) {
+  const auto s = sectionAt(t, p.z());
+  if (!s)
+    return std::nullopt;
+  return (p.head<2>() - s->axis).norm() - s->radius;
+}
+
+/// Where track a ran onto another column b: the index of a's first circle whose centre lies
+/// inside b's surface, when the two stood clear of each other at the lowest height both reach
+/// and a, not b, moved across (a's axis moved farther from there than b's); nothing otherwise.
+std::optional<std::size_t> joinsOnto(const TrackedTrunk& a, const TrackedTrunk& b) {
+  if (a.centers.empty() || b.centers.empty())
+    return std::nullopt;
+  const double z0 = std::max(a.centers.front().z(), b.centers.front().z());
+  const auto a0 = sectionAt(a, z0), b0 = sectionAt(b, z0);
+  if (!a0 || !b0 || (a0->axis - b0->axis).norm() <= a0->radius + b0->radius)
+    return std::nullopt;
+  for (std::size_t i = 0; i < a.centers.size(); ++i) {
+    const auto gap = a.centers[i].z() >= z0 ? surfaceGapAt(b, a.centers[i]) : std::nullopt;
+    if (!gap || *gap >= 0.0)
+      continue;
+    const double a_moved = (a.centers[i].head<2>() - a0->axis).norm();
+    const double b_moved = (sectionAt(b, a.centers[i].z())->axis - b0->axis).norm();
+    if (a_moved > b_moved)
+      return i;
+    return std::nullopt;
+  }
+  return std::nullopt;
 }
 
 /// Whether track b keeps clear of track a's surface: at each of b's circles within a's span
@@ -486,26 +523,33 @@ void trackStarts(const Points& pts, const PointIndex& index, const std::vector<T
     if (!starts[k].usable)
       return;
     TrackedTrunk tracked = climbFrom(pts, index, starts[k], threshold, frame.zmax, config);
-    if (tracked.centers.size() >= 3)
+    if (tracked.centers.size() >= MIN_TRACK_CIRCLES)
       (*tracks)[k] = std::move(tracked);
   });
 }
 
-/// Every track resumed past a whorl that ended it (resumePastWhorls), then scored (-1 where
-/// there is no track). Only after the density columns are chosen, on what stood before: a
-/// track around a young trunk's smear of mixed pixels (a circle of 12 cm radius) ends low and
-/// leaves the trunk to its column; resumed, it climbs to the top.
-void resumeAndScore(const Points& pts, const PointIndex& index,
-                    const std::vector<TrunkStart>& starts, double threshold,
-                    const SearchFrame& frame, const ModelerConfig& config,
-                    std::vector<std::optional<TrackedTrunk>>* tracks, std::vector<double>* scores) {
-  scores->assign(starts.size(), -1.0);
-  parallelFor(static_cast<int>(starts.size()), [&](int k) {
-    if (!(*tracks)[k])
-      return;
-    (*tracks)[k] = resumePastWhorls(pts, index, std::move(*(*tracks)[k]), threshold, config);
-    (*scores)[k] = trackScore(index, *(*tracks)[k], starts[k], frame);
+/// Every track resumed past a whorl that ended it (resumePastWhorls). Only after the density
+/// columns are chosen, on what stood before: a track around a young trunk's smear of mixed
+/// pixels (a circle of 12 cm radius) ends low and leaves the trunk to its column; resumed, it
+/// climbs to the top.
+void resumeTracks(const Points& pts, const PointIndex& index, double threshold,
+                  const ModelerConfig& config, std::vector<std::optional<TrackedTrunk>>* tracks) {
+  parallelFor(static_cast<int>(tracks->size()), [&](int k) {
+    if ((*tracks)[k])
+      (*tracks)[k] = resumePastWhorls(pts, index, std::move(*(*tracks)[k]), threshold, config);
   });
+}
+
+/// Each track's score (trackScore), -1 where there is no track.
+std::vector<double> scoreTracks(const PointIndex& index, const std::vector<TrunkStart>& starts,
+                                const SearchFrame& frame,
+                                const std::vector<std::optional<TrackedTrunk>>& tracks) {
+  std::vector<double> scores(starts.size(), -1.0);
+  parallelFor(static_cast<int>(starts.size()), [&](int k) {
+    if (tracks[k])
+      scores[k] = trackScore(index, *tracks[k], starts[k], frame);
+  });
+  return scores;
 }
 
 /// The starts whose tracks climb at least half of the clouds' height above them: what stands
@@ -545,6 +589,30 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
 
 }  // namespace
 
+void cutWhereJoined(std::vector<std::optional<TrackedTrunk>>* tracks) {
+  const std::size_t m = tracks->size();
+  std::vector<std::size_t> keep(m, std::numeric_limits<std::size_t>::max());
+  for (std::size_t a = 0; a < m; ++a) {
+    for (std::size_t b = 0; b < m; ++b) {
+      if (a == b || !(*tracks)[a] || !(*tracks)[b])
+        continue;
+      if (const auto i = joinsOnto(*(*tracks)[a], *(*tracks)[b]))
+        keep[a] = std::min(keep[a], *i);
+    }
+  }
+  for (std::size_t a = 0; a < m; ++a) {
+    auto& t = (*tracks)[a];
+    if (!t || keep[a] >= t->centers.size())
+      continue;
+    if (keep[a] < MIN_TRACK_CIRCLES) {
+      t.reset();
+      continue;
+    }
+    t->centers.resize(keep[a]);
+    t->radii.resize(keep[a]);
+  }
+}
+
 int chooseTrunkTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
                      const std::vector<double>& scores, double zmin, std::vector<int>* groups) {
   const TrackGroups g = groupTracks(tracks);
@@ -562,7 +630,6 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   std::vector<TrunkStart> starts = clusterTrunkStarts(clusters, path, frame.zmin, config);
   const double threshold = trackingThreshold(pts, clusters, starts, config);
   std::vector<std::optional<TrackedTrunk>> tracks;
-  std::vector<double> scores;
   trackStarts(pts, index, starts, 0, threshold, frame, config, &tracks);
   // Then the dense columns that no standing track explains, in the same start order.
   std::vector<double> radii;
@@ -577,7 +644,9 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     starts.insert(starts.end(), columns.begin(), columns.end());
     trackStarts(pts, index, starts, from, threshold, frame, config, &tracks);
   }
-  resumeAndScore(pts, index, starts, threshold, frame, config, &tracks, &scores);
+  resumeTracks(pts, index, threshold, config, &tracks);
+  cutWhereJoined(&tracks);
+  const std::vector<double> scores = scoreTracks(index, starts, frame, tracks);
   const TrackGroups groups = groupTracks(tracks);
   const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);

@@ -554,6 +554,38 @@ TEST(TrunkSearch, ATrackThatStoppedLowDoesNotRepresentItsTrunk) {
   EXPECT_EQ(chooseTrunkTrack({tracks[0], std::nullopt, tracks[2]}, {1.0, -1.0, 1.0}, 0.1), 0);
 }
 
+TEST(TrunkSearch, ATrackThatRanOntoAPostIsCutWhereItJoinedIt) {
+  // A trunk (r 3 cm), a post 0.5 m away (r 5 cm), and a track from the trunk's base whose
+  // radius a dense whorl widened to 9 cm from 0.5 m: it drifts across to the post by 1.3 m and
+  // follows it to its top (seed 112's dense-whorl tree at 12 mm: the post was its trunk, F1
+  // 0 %). It is cut below its first circle inside the post (x > 0.45 m, at 1.25 m); the trunk
+  // and the post, which it did not move onto, are left whole.
+  const auto trunk = [](double) { return Eigen::Vector2d(0.0, 0.0); };
+  const auto post = [](double) { return Eigen::Vector2d(0.5, 0.0); };
+  const auto drift = [](double z) {
+    return Eigen::Vector2d(std::clamp(0.5 * (z - 0.5) / 0.8, 0.0, 0.5), 0.0);
+  };
+  std::vector<std::optional<TrackedTrunk>> tracks = {trackAlong(3.0, trunk), trackAlong(3.3, post),
+                                                     trackAlong(3.3, drift)};
+  for (auto& r : tracks[1]->radii)
+    r = 0.05;
+  for (std::size_t k = 0; k < tracks[2]->radii.size(); ++k)
+    tracks[2]->radii[k] = tracks[2]->centers[k].z() < 0.5 ? 0.03 : 0.09;
+  const auto before = tracks;
+  cutWhereJoined(&tracks);
+  ASSERT_TRUE(tracks[0] && tracks[1] && tracks[2]);
+  EXPECT_EQ(tracks[0]->centers, before[0]->centers);
+  EXPECT_EQ(tracks[1]->centers, before[1]->centers);
+  EXPECT_NEAR(tracks[2]->centers.back().z(), 1.2, 1e-9);
+  EXPECT_EQ(tracks[2]->radii.size(), tracks[2]->centers.size());
+  // Cut to fewer than 3 circles, a track is none.
+  const auto dash = [](double z) { return Eigen::Vector2d(std::min(0.5, 10.0 * (z - 0.1)), 0.0); };
+  std::vector<std::optional<TrackedTrunk>> early = {before[1], trackAlong(3.3, dash)};
+  cutWhereJoined(&early);
+  EXPECT_TRUE(early[0]);
+  EXPECT_FALSE(early[1]);
+}
+
 TEST(TrunkModel, ALeaderThatBendsIsSplitWhereItLeavesTheChord) {
   // A trunk whose centreline curves 10 cm off the vertical over 1.6 m (x = 0.1 (z / 1.6)^2):
   // one cylinder over it lies 2.5 cm off the wood at mid height, on every side of the bend.

@@ -76,6 +76,16 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
 std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
                                   double band);
 
+/// @brief Cuts each track that ran onto another column below the circle where it joined it,
+/// and empties one left with fewer than 3 circles. A track joins column b where its centre
+/// first lies inside b's surface, when the two stood clear of each other (their surfaces apart)
+/// at the lowest height both reach and the track, not b, moved across: its axis moved farther
+/// from there than b's. Two columns standing apart at their feet do not become one; a trunk's
+/// track whose radius a dense whorl widened wanders off and can end on a trellis post.
+/// @param tracks one per start, empty where the start gave no track; cut in place, each
+///        against the others as they were given
+void cutWhereJoined(std::vector<std::optional<TrackedTrunk>>* tracks);
+
 /// @brief The trunk among tracked candidates. Tracks whose lowest BASE_HEIGHT stand on one base
 /// are one trunk (a group); a group scores the median of its voters, the tracks that climb
 /// most of its height (a track that stopped at a whorl has a small shell), and is represented
