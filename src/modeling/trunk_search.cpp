@@ -206,9 +206,7 @@ std::optional<std::size_t> joinsOnto(const TrackedTrunk& a, const TrackedTrunk& 
       continue;
     const double a_moved = (a.centers[i].head<2>() - a0->axis).norm();
     const double b_moved = (sectionAt(b, a.centers[i].z())->axis - b0->axis).norm();
-    if (a_moved > b_moved)
-      return i;
-    return std::nullopt;
+    return a_moved > b_moved ? std::optional<std::size_t>(i) : std::nullopt;
   }
   return std::nullopt;
 }
