@@ -295,18 +295,6 @@ bool plausibleArc(const std::optional<Circle>& circle, double radius) {
          circle->radius < radius * ARC_RADIUS_SHARE && circle->center.norm() < radius;
 }
 
-/// Where one slice's cross-section is centred, as an offset from its centroid: `section` holds
-/// its points across the axis, about that centroid. A centroid lies on whatever part of the
-/// section was seen or kept (the side facing the scanner, the near side the reach left, bark
-/// at a branch's base); a branch thick enough to show its arc (arc_radius > 0) is centred on
-/// the circle its points lie on when that circle is plausible.
-Eigen::Vector2d arcOffset(const Points2& section, double arc_radius) {
-  if (arc_radius <= 0.0 || static_cast<int>(section.size()) < MIN_ARC_POINTS)
-    return Eigen::Vector2d::Zero();
-  const auto circle = fitCircle(section);
-  return plausibleArc(circle, arc_radius) ? circle->center : Eigen::Vector2d::Zero();
-}
-
 /// The points within `band` of the line through o along d, into *out (its storage reused:
 /// RANSAC calls this a hundred times a fit).
 void nearLine(const Points& pts, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double band,
@@ -364,18 +352,25 @@ long thinSlice(const Cylinder& cyl, const Eigen::Vector3d& p) {
 }
 
 /// The centre of one slice's points (`slice` indexes pts; u and v span the plane across the
-/// axis): their centroid, moved onto their arc (arcOffset).
+/// axis). A centroid lies on whatever part of the section was seen or kept (the side facing
+/// the scanner, the near side the reach left, bark at a branch's base): a branch thick enough
+/// to show its arc (arc_radius > 0) is centred on the circle its points lie on when that
+/// circle is plausible and the slice holds MIN_ARC_POINTS; otherwise the centre is the centroid.
 Eigen::Vector3d sliceCentre(const Points& pts, const std::vector<int>& slice,
                             const Eigen::Vector3d& u, const Eigen::Vector3d& v, double arc_radius) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const int i : slice)
     centroid += pts[i];
   centroid /= static_cast<double>(slice.size());
+  if (arc_radius <= 0.0 || static_cast<int>(slice.size()) < MIN_ARC_POINTS)
+    return centroid;
   Points2 section;
   for (const int i : slice)
     section.emplace_back((pts[i] - centroid).dot(u), (pts[i] - centroid).dot(v));
-  const Eigen::Vector2d off = arcOffset(section, arc_radius);
-  return centroid + off.x() * u + off.y() * v;
+  const auto circle = fitCircle(section);
+  if (!plausibleArc(circle, arc_radius))
+    return centroid;
+  return centroid + circle->center.x() * u + circle->center.y() * v;
 }
 
 /// The points of `best` within `reach` of the axis (empty below MIN_THIN_POINTS), and the axis

@@ -114,11 +114,15 @@ double trackingThreshold(const Points& pts, const std::vector<Cluster>& clusters
   return std::max(0.5 * config.fit.circle_threshold_m, noiseBand(median(guesses)));
 }
 
+/// How high a track climbs above its start (m), 0 without circles.
+double climbAbove(const TrackedTrunk& t, const TrunkStart& start) {
+  return t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
+}
+
 /// Whether a track stands on its start's trunk: it climbs at least STANDING_CLIMB of the
 /// clusters' height above the start (`zmax`: the highest cluster centroid's z, m).
 bool stands(const TrackedTrunk& t, const TrunkStart& start, double zmax) {
-  const double climb = t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
-  return climb >= STANDING_CLIMB * (zmax - start.base.z());
+  return climbAbove(t, start) >= STANDING_CLIMB * (zmax - start.base.z());
 }
 
 /// Up from the start, retried from a trusted radius when the free first circle stopped it low,
@@ -129,15 +133,12 @@ TrackedTrunk climbFrom(const Points& pts, const PointIndex& index, const TrunkSt
   // oblique first slice cuts the trunk in an ellipse. The track bends to the trunk's lean.
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   TrackedTrunk tracked = trackTrunk(pts, index, start.base, up, start.radius, threshold, config);
-  const auto climb = [&](const TrackedTrunk& t) {
-    return t.centers.empty() ? 0.0 : t.centers.back().z() - start.base.z();
-  };
   const auto retry = [&](double radius) {
     if (stands(tracked, start, zmax))
       return;
     TrackedTrunk again =
         trackTrunk(pts, index, start.base, up, radius, threshold, config, RETRY_MISSES, true);
-    if (climb(again) > climb(tracked))
+    if (climbAbove(again, start) > climbAbove(tracked, start))
       tracked = std::move(again);
   };
   // The free first circle can take in what stands around the base (suckers, weeds, soil
