@@ -34,6 +34,23 @@ double stepSpread(const Samples& pts) {
   return std::max(sigmaFromAbsoluteDeviations(std::move(steps)) / std::sqrt(2.0), MIN_SPREAD);
 }
 
+/// Robust sigma of the honest slices' scatter about the profile, the smaller of two readings
+/// that wide slices inflate in different ways: over every slice from `base` on (when more
+/// than half read wide, as among steep scaffolds, their residuals set it) and over those under
+/// the profile (when wide slices pull the profile above all the honest ones, theirs set it).
+double honestSpread(const std::vector<double>& residuals, std::size_t base) {
+  std::vector<double> all, under;
+  for (std::size_t k = base; k < residuals.size(); ++k) {
+    all.push_back(std::abs(residuals[k]));
+    if (residuals[k] < 0.0)
+      under.push_back(-residuals[k]);
+  }
+  double spread = sigmaFromAbsoluteDeviations(std::move(all));
+  if (!under.empty())
+    spread = std::min(spread, sigmaFromAbsoluteDeviations(std::move(under)));
+  return std::max(spread, MIN_SPREAD);
+}
+
 /// The number of lowest slices the ground's mixed pixels cut: the longest run within
 /// GROUND_MIXING_HEIGHT of the lowest slice whose every slice reads under the median of the
 /// slices just above the run. A trunk thins upwards, so no honest base slice does.
@@ -97,12 +114,10 @@ std::optional<TaperProfile> TaperProfile::fit(const std::vector<Slice>& slices, 
     if (!c.allFinite())
       return std::nullopt;
     p.c_ = c;
-    std::vector<double> residuals(pts.size()), magnitude(pts.size());
-    for (std::size_t k = 0; k < pts.size(); ++k) {
+    std::vector<double> residuals(pts.size());
+    for (std::size_t k = 0; k < pts.size(); ++k)
       residuals[k] = pts[k].second - p.at(pts[k].first);
-      magnitude[k] = std::abs(residuals[k]);
-    }
-    const double spread = std::max(sigmaFromAbsoluteDeviations(std::move(magnitude)), MIN_SPREAD);
+    const double spread = honestSpread(residuals, base);
     for (std::size_t k = 0; k < pts.size(); ++k)
       used[k] = k >= base && residuals[k] > -below * spread && residuals[k] < above * spread;
   }

@@ -16,8 +16,11 @@ namespace modeling {
 /// At 12 mm range noise a single slice's radius scatters by millimetres and the slices through
 /// branch bases read centimetres wide; a segment's median slice carries both. The profile is
 /// fitted to all slices at once, in rounds that leave out slices more than `below` robust
-/// standard deviations (1.4826 x median absolute residual) under it or `above` over it (a
-/// branch base only widens a slice: the upper bound may be the tighter one).
+/// standard deviations under it or `above` over it (a branch base only widens a slice: the
+/// upper bound may be the tighter one). The robust standard deviation (1.4826 x median
+/// absolute residual) is the smaller of that over every slice and that over the slices under
+/// the profile: wide slices inflate each in their own case (among steep scaffolds more than
+/// half of the slices read wide; wide slices can lift the profile above every honest one).
 ///
 /// The lowest slices are left out where they all read under the slices just above them: the
 /// ground's mixed pixels pull a trunk base's circles in (a trunk thins upwards, so no honest
