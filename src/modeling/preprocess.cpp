@@ -66,6 +66,10 @@ constexpr double WIRE_COVER_BIN = 0.02;  // m
 constexpr double WIRE_MIN_COVER = 0.95;
 // The wires of a trellis are decimetres apart: a spot this near a wire's line is its fringe.
 constexpr double WIRE_SEPARATION = 2.0 * WIRE_BAND;
+// A crop cut tight around a narrow tree holds its wires shorter than any wire length: a line
+// that runs across this share of the cloud's extent along it, edge to edge, is as long as a
+// wire there can be (a branch ends at its trunk; two in line do not fill WIRE_MIN_COVER).
+constexpr double WIRE_CROP_SPAN = 0.9;
 
 /// Downsamples pts again on coarser grids until at most `cap` are left.
 /// @param voxel the grid pts were downsampled on (m); receives the grid used
@@ -322,6 +326,18 @@ std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run,
   return inliers;
 }
 
+/// The run (m) a line must hold to be a wire: min_length, or WIRE_CROP_SPAN of the cloud's
+/// extent along the line where the cloud is shorter.
+double wireRunNeeded(const Points& pts, const WireLine& line, double min_length) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& p : pts) {
+    const double t = p.dot(line.direction);
+    lo = std::min(lo, t);
+    hi = std::max(hi, t);
+  }
+  return hi > lo ? std::min(min_length, WIRE_CROP_SPAN * (hi - lo)) : min_length;
+}
+
 /// Keeps the candidates off the line: whatever the verdict, those on it are settled.
 void settle(std::vector<int>& candidates, const Points& pts, const WireLine& line) {
   std::vector<int> rest;
@@ -455,7 +471,7 @@ void addParallelWires(const Points& pts, double min_length, std::vector<FoundWir
     if (std::any_of(lines.begin(), lines.end(), known))
       continue;
     ++tried;
-    if (sampleRun(pts, row, spot) < min_length)
+    if (sampleRun(pts, row, spot) < wireRunNeeded(pts, spot, min_length))
       continue;
     const WireLine line = refineLine(pts, spot);
     if (std::abs(line.direction.dot(row.along)) < std::cos(WIRE_MAX_CROSSING))
@@ -463,7 +479,7 @@ void addParallelWires(const Points& pts, double min_length, std::vector<FoundWir
     double run = 0.0, cover = 0.0;
     std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     lines.push_back(line);
-    if (run >= min_length && cover >= WIRE_MIN_COVER)
+    if (run >= wireRunNeeded(pts, line, min_length) && cover >= WIRE_MIN_COVER)
       wires.push_back({line.direction, std::move(inliers), line});
   }
 }
@@ -482,7 +498,7 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     double run = 0.0, cover = 0.0;
     std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     settle(candidates, pts, line);
-    if (run < min_length || cover < WIRE_MIN_COVER)
+    if (run < wireRunNeeded(pts, line, min_length) || cover < WIRE_MIN_COVER)
       continue;
     // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
     Points points;

@@ -279,6 +279,38 @@ TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
   EXPECT_GT(onTrunk(out), 0.95 * onTrunk(voxelDownsample(pts, config.preprocess.voxel_size_m)));
 }
 
+TEST(Preprocess, RemovesAWireThatACropCutShorterThanAnyWire) {
+  // A crop 0.8 m along the row around a narrow tree: a trunk, a noisy wire at 1.2 m crossing
+  // the whole crop beside it, and a level branch along the row at 0.8 m from the trunk to the
+  // crop's edge. The wire runs 0.8 m, under wire_min_length_m, but from edge to edge: it goes.
+  // The branch, as straight and level, ends at the trunk: it stays.
+  Rng rng(9);
+  Points pts;
+  for (int i = 0; i < 20000; ++i) {
+    const double a = rng.uniform(0.0, 2.0 * M_PI);
+    pts.push_back(Eigen::Vector3d(0.035 * std::cos(a), 0.035 * std::sin(a), rng.uniform(0.1, 2.0)));
+  }
+  for (int i = 0; i < 1500; ++i) {
+    pts.push_back(Eigen::Vector3d(rng.uniform(-0.4, 0.4), 0.06 + rng.normal(0.0, 0.006),
+                                  1.2 + rng.normal(0.0, 0.006)));
+    pts.push_back(Eigen::Vector3d(rng.uniform(0.035, 0.4), rng.normal(0.0, 0.006),
+                                  0.8 + rng.normal(0.0, 0.006)));
+  }
+  ModelerConfig config;
+  config.preprocess.voxel_size_m = 0.0;
+  ASSERT_GT(config.preprocess.wire_min_length_m, 0.8);
+  PreprocessStats stats;
+  const Points out = preprocess(pts, config, &stats);
+  const auto near = [&](double y, double z) {
+    return std::count_if(out.begin(), out.end(), [&](const Eigen::Vector3d& p) {
+      return p.x() > 0.05 && std::hypot(p.y() - y, p.z() - z) < 0.015;
+    });
+  };
+  EXPECT_EQ(stats.wire_directions.size(), 1u);
+  EXPECT_LT(near(0.06, 1.2), 20) << "the wire is removed";
+  EXPECT_GT(near(0.0, 0.8), 1200) << "the branch stays";
+}
+
 TEST(Preprocess, FindsAWireWhoseNeighbourhoodIsNoLineAndKeepsAGappyRowOfBranches) {
   // Three noisy wires along x across a 2 m crop. The top one has a branch trained along it
   // 4 cm off and shoots crossing it every 10 cm, so no 10 cm ball on it is a line and only
