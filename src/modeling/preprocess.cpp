@@ -326,16 +326,19 @@ std::vector<int> lineRun(const Points& pts, const WireLine& line, double* run,
   return inliers;
 }
 
-/// The run (m) a line must hold to be a wire: min_length, or WIRE_CROP_SPAN of the cloud's
-/// extent along the line where the cloud is shorter.
-double wireRunNeeded(const Points& pts, const WireLine& line, double min_length) {
+/// Whether a run (m) along a line is as long as a wire: min_length, or WIRE_CROP_SPAN of the
+/// cloud's extent along the line where the cloud is shorter. The extent, a pass over the
+/// cloud, is read only for runs under min_length.
+bool wireLong(const Points& pts, const WireLine& line, double run, double min_length) {
+  if (run >= min_length)
+    return true;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& p : pts) {
     const double t = p.dot(line.direction);
     lo = std::min(lo, t);
     hi = std::max(hi, t);
   }
-  return hi > lo ? std::min(min_length, WIRE_CROP_SPAN * (hi - lo)) : min_length;
+  return hi > lo && run >= WIRE_CROP_SPAN * (hi - lo);
 }
 
 /// Keeps the candidates off the line: whatever the verdict, those on it are settled.
@@ -471,7 +474,7 @@ void addParallelWires(const Points& pts, double min_length, std::vector<FoundWir
     if (std::any_of(lines.begin(), lines.end(), known))
       continue;
     ++tried;
-    if (sampleRun(pts, row, spot) < wireRunNeeded(pts, spot, min_length))
+    if (!wireLong(pts, spot, sampleRun(pts, row, spot), min_length))
       continue;
     const WireLine line = refineLine(pts, spot);
     if (std::abs(line.direction.dot(row.along)) < std::cos(WIRE_MAX_CROSSING))
@@ -479,7 +482,7 @@ void addParallelWires(const Points& pts, double min_length, std::vector<FoundWir
     double run = 0.0, cover = 0.0;
     std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     lines.push_back(line);
-    if (run >= wireRunNeeded(pts, line, min_length) && cover >= WIRE_MIN_COVER)
+    if (wireLong(pts, line, run, min_length) && cover >= WIRE_MIN_COVER)
       wires.push_back({line.direction, std::move(inliers), line});
   }
 }
@@ -498,7 +501,7 @@ std::size_t removeWires(Points& pts, double min_length, std::uint64_t seed,
     double run = 0.0, cover = 0.0;
     std::vector<int> inliers = lineRun(pts, line, &run, &cover);
     settle(candidates, pts, line);
-    if (run < wireRunNeeded(pts, line, min_length) || cover < WIRE_MIN_COVER)
+    if (!wireLong(pts, line, run, min_length) || cover < WIRE_MIN_COVER)
       continue;
     // Two sampled points fix the line to a few degrees; all its points to a fraction of one.
     Points points;

@@ -195,14 +195,19 @@ TEST(NeighbourGrowthDimension, LinesSurfacesAndVolumesReadOneTwoAndThree) {
   EXPECT_EQ(dimension(lonely), 0.0) << "no neighbours: no dimension";
 }
 
-/// A 5 cm trunk standing on z = 0, 1.5 m tall.
-Points standingTrunk(Rng& rng) {
+/// 20000 points on an upright trunk of `radius` (m) about the z axis, from z0 to z1 (m).
+Points uprightTrunk(Rng& rng, double radius, double z0, double z1) {
   Points pts;
   for (int i = 0; i < 20000; ++i) {
     const double a = rng.uniform(0.0, 2.0 * M_PI);
-    pts.push_back(Eigen::Vector3d(0.025 * std::cos(a), 0.025 * std::sin(a), rng.uniform(0.0, 1.5)));
+    pts.push_back(Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), rng.uniform(z0, z1)));
   }
   return pts;
+}
+
+/// A 5 cm trunk standing on z = 0, 1.5 m tall.
+Points standingTrunk(Rng& rng) {
+  return uprightTrunk(rng, 0.025, 0.0, 1.5);
 }
 
 /// Points within `radius` of the z axis, above `z`.
@@ -254,11 +259,7 @@ TEST(Preprocess, RemovesAWireAndReportsItsDirection) {
   // A trunk, and a noisy 2 m wire beside it, not quite along x: the wire goes, its direction
   // is reported (the modeler takes short wire pieces as parallel to it), the trunk stays.
   Rng rng(3);
-  Points pts;
-  for (int i = 0; i < 20000; ++i) {
-    const double a = rng.uniform(0.0, 2.0 * M_PI);
-    pts.push_back(Eigen::Vector3d(0.05 * std::cos(a), 0.05 * std::sin(a), rng.uniform(0.1, 2.0)));
-  }
+  Points pts = uprightTrunk(rng, 0.05, 0.1, 2.0);
   const Eigen::Vector3d along = Eigen::Vector3d(1.0, 0.2, 0.0).normalized();
   const Eigen::Vector3d start(-1.0, -0.1, 1.2);  // passes the trunk's axis 10 cm off
   for (int i = 0; i < 2000; ++i) {
@@ -285,11 +286,7 @@ TEST(Preprocess, RemovesAWireThatACropCutShorterThanAnyWire) {
   // crop's edge. The wire runs 0.8 m, under wire_min_length_m, but from edge to edge: it goes.
   // The branch, as straight and level, ends at the trunk: it stays.
   Rng rng(9);
-  Points pts;
-  for (int i = 0; i < 20000; ++i) {
-    const double a = rng.uniform(0.0, 2.0 * M_PI);
-    pts.push_back(Eigen::Vector3d(0.035 * std::cos(a), 0.035 * std::sin(a), rng.uniform(0.1, 2.0)));
-  }
+  Points pts = uprightTrunk(rng, 0.035, 0.1, 2.0);
   for (int i = 0; i < 1500; ++i) {
     pts.push_back(Eigen::Vector3d(rng.uniform(-0.4, 0.4), 0.06 + rng.normal(0.0, 0.006),
                                   1.2 + rng.normal(0.0, 0.006)));
