@@ -27,9 +27,12 @@ constexpr double GROUND_REACH = 0.3;        // m above the cloud's bottom a trun
 constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow one trunk
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
-// A track whose top third is at least this share of its bottom third's radius does not taper:
-// a trellis post or a pole, scored at POLE_WEIGHT (a tree's trunk tapers; one post beside a
-// tree gathers the tree's branches in its shell and outscored the trunk on two test trees).
+// A track whose top third is at least this share of its bottom third's radius does not taper.
+// A group of tracks none of which tapers is a trellis post or a pole, scored at POLE_WEIGHT (a
+// tree's trunk tapers; one post beside a tree gathers the tree's branches in its shell and
+// outscored the trunk on two test trees). One tapering track is enough: a track that follows
+// a steep scaffold beside the leader grows with it and no longer tapers, where a post's tracks
+// cannot narrow.
 constexpr double POLE_TAPER = 0.9;
 constexpr double POLE_WEIGHT = 0.5;
 constexpr double RETRY_WIDTH = 1.6;     // first circle / start radius above which a low track
@@ -223,8 +226,18 @@ bool keepsClear(const TrackedTrunk& a, const TrackedTrunk& b, double band) {
   return true;
 }
 
+/// Whether a track narrows upwards (POLE_TAPER). One too short to tell counts as tapering.
+bool tapers(const TrackedTrunk& t) {
+  const std::size_t third = t.radii.size() / 3;
+  if (third < 3)
+    return true;
+  const std::vector<double> lower(t.radii.begin(), t.radii.begin() + third);
+  const std::vector<double> upper(t.radii.end() - third, t.radii.end());
+  return median(upper) < POLE_TAPER * median(lower);
+}
+
 /// Branch points in the shell around a track, weighted down for a start far from the crop's
-/// centre, a track floating above the ground and one that does not taper (a post).
+/// centre and a track floating above the ground.
 double trackScore(const PointIndex& index, const TrackedTrunk& tracked, const TrunkStart& start,
                   const SearchFrame& frame) {
   double shell = 0.0;
@@ -240,15 +253,7 @@ double trackScore(const PointIndex& index, const TrackedTrunk& tracked, const Tr
   for (const auto& p : tracked.centers)
     lowest = std::min(lowest, p.z());
   const double floating = std::max(0.0, lowest - (frame.zmin + GROUND_REACH)) / GROUND_REACH;
-  const std::size_t third = tracked.radii.size() / 3;
-  double pole = 1.0;
-  if (third >= 3) {
-    const std::vector<double> lower(tracked.radii.begin(), tracked.radii.begin() + third);
-    const std::vector<double> upper(tracked.radii.end() - third, tracked.radii.end());
-    if (median(upper) >= POLE_TAPER * median(lower))
-      pole = POLE_WEIGHT;
-  }
-  return pole * shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
+  return shell * std::exp(-off_centre * off_centre) * std::exp(-floating * floating);
 }
 
 /// Tracks that stand on one base (median offset over their lowest BASE_HEIGHT below a radius)
@@ -338,9 +343,26 @@ int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const
   return chosen;
 }
 
-/// The best group scores the median of its voting tracks: only those that climb most of the
+/// A group's score: the median of its voting tracks' (only those that climb most of the
 /// group's height vote, since a track that stopped at a whorl low on the trunk has a small
-/// shell and would drag its trunk below a neighbour's. Returns its representative, or -1.
+/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when none tapers.
+/// Negative when it has no voter.
+double groupScore(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                  const std::vector<double>& scores, const std::vector<char>& voters) {
+  std::vector<double> member_scores;
+  bool tapering = false;
+  for (std::size_t k = 0; k < tracks.size(); ++k) {
+    if (!voters[k])
+      continue;
+    member_scores.push_back(scores[k]);
+    tapering = tapering || tapers(*tracks[k]);
+  }
+  if (member_scores.empty())
+    return -1.0;
+  return (tapering ? 1.0 : POLE_WEIGHT) * median(std::move(member_scores));
+}
+
+/// The best-scoring group's representative (groupScore), or -1.
 int chooseTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
                 const std::vector<double>& scores, const TrackGroups& g, double zmin) {
   const int m = static_cast<int>(tracks.size());
@@ -348,15 +370,8 @@ int chooseTrack(const std::vector<std::optional<TrackedTrunk>>& tracks,
   double best_score = -1.0;
   for (int group = 0; group < m; ++group) {
     const std::vector<char> voters = groupVoters(tracks, g, group, zmin);
-    std::vector<double> member_scores;
-    for (int k = 0; k < m; ++k) {
-      if (voters[k])
-        member_scores.push_back(scores[k]);
-    }
-    if (member_scores.empty())
-      continue;
-    const double score = median(member_scores);
-    if (score <= best_score)
+    const double score = groupScore(tracks, scores, voters);
+    if (score < 0.0 || score <= best_score)
       continue;
     best_score = score;
     chosen = representative(tracks, g, voters);
@@ -383,6 +398,7 @@ std::vector<TrunkCandidate> candidateReport(const std::vector<TrunkStart>& start
     r.top = tracks[k]->centers.back().z();
     r.median_radius = median(tracks[k]->radii);
     r.score = scores[k];
+    r.tapers = tapers(*tracks[k]);
     r.group = groups[k];
     r.chosen = static_cast<int>(k) == chosen;
   }

@@ -120,7 +120,8 @@ int main(int argc, char** argv) {
                   << c.start.x() << ", " << c.start.y() << ", " << c.start.z() << ") r "
                   << 1000.0 * c.start_radius << " mm: " << c.slices << " circles, z " << c.bottom
                   << ".." << c.top << ", median r " << 1000.0 * c.median_radius << " mm, score "
-                  << c.score << ", trunk " << c.group << (c.chosen ? "  <- trunk" : "")
+                  << c.score << (c.slices > 0 && !c.tapers ? " (no taper)" : "") << ", trunk "
+                  << c.group << (c.chosen ? "  <- trunk" : "")
                   << (c.other_column ? "  <- another column" : "") << "\n";
       }
       std::cerr << "  " << result.column_points

@@ -388,8 +388,9 @@ TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
   EXPECT_LT(track.centers.back().z(), 1.0);
   EXPECT_GT(resumed.centers.back().z(), 2.3);
   for (const auto& c : resumed.centers) {
-    if (c.z() > 0.8)
+    if (c.z() > 0.8) {
       EXPECT_LT(c.head<2>().norm(), 0.015) << "at " << c.z() << " m";
+    }
   }
 }
 
@@ -582,6 +583,39 @@ TEST(TrunkSearch, ATrackThatStoppedLowDoesNotRepresentItsTrunk) {
   EXPECT_EQ(groups, (std::vector<int>{0, 0, 0}));
   // Without the short track the two voters stray alike; the higher one still represents.
   EXPECT_EQ(chooseTrunkTrack({tracks[0], std::nullopt, tracks[2]}, {1.0, -1.0, 1.0}, 0.1), 0);
+}
+
+TEST(TrunkSearch, ATreeWhoseTracksGrewOnSteepScaffoldsOutscoresAPost) {
+  // Three tracks from one base (the steep-scaffold tree of seed 107 at 3 mm): one climbs the
+  // leader and narrows from 34 to 15 mm; two stay 1 cm beside it from 0.6 m, on steep
+  // scaffolds, and keep 35-40 mm. A post (r 45 mm) 0.45 m away gathers the tree's branches in
+  // its shell. Scored track by track, two of the tree's three read as posts and the post was
+  // the trunk (F1 10 %); one narrowing track shows the group is a tree.
+  const auto leader = [](double) { return Eigen::Vector2d(0.0, 0.0); };
+  const auto beside = [](double side) {
+    return [side](double z) { return Eigen::Vector2d(z > 0.6 ? side : 0.0, 0.0); };
+  };
+  const auto post = [](double) { return Eigen::Vector2d(0.45, 0.0); };
+  std::vector<std::optional<TrackedTrunk>> tracks = {
+      trackAlong(2.7, leader), trackAlong(2.75, beside(0.01)), trackAlong(2.72, beside(-0.01)),
+      trackAlong(3.0, post), trackAlong(3.0, post)};
+  for (std::size_t k = 0; k < tracks[0]->radii.size(); ++k)
+    tracks[0]->radii[k] = 0.035 - 0.0075 * tracks[0]->centers[k].z();
+  for (int t = 1; t <= 2; ++t) {
+    for (std::size_t k = 0; k < tracks[t]->radii.size(); ++k)
+      tracks[t]->radii[k] = tracks[t]->centers[k].z() > 0.6 ? 0.04 : 0.035;
+  }
+  for (int t = 3; t <= 4; ++t)
+    std::fill(tracks[t]->radii.begin(), tracks[t]->radii.end(), 0.045);
+  std::vector<int> groups;
+  const int chosen = chooseTrunkTrack(tracks, {0.64, 0.55, 0.52, 0.63, 0.63}, 0.1, &groups);
+  EXPECT_EQ(groups, (std::vector<int>{0, 0, 0, 3, 3}));
+  ASSERT_GE(chosen, 0);
+  EXPECT_EQ(groups[chosen], 0);
+  // Without the narrowing track the tree's group reads as a post as well.
+  EXPECT_EQ(chooseTrunkTrack({std::nullopt, tracks[1], tracks[2], tracks[3], tracks[4]},
+                             {-1.0, 0.55, 0.52, 0.63, 0.63}, 0.1),
+            3);
 }
 
 TEST(TrunkSearch, ATrackThatRanOntoAPostIsCutWhereItJoinedIt) {

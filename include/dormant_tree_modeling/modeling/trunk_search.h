@@ -21,8 +21,10 @@ struct TrunkCandidate {
   double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
   double median_radius = 0.0;      ///< of the track's circles (m)
   double score = -1.0;             ///< branch points around it, weighted
-  int group = -1;                  ///< candidates whose tracks follow one trunk share a group
-  bool chosen = false;             ///< the track that became the trunk's axis
+  /// its radius narrows upwards; a group none of whose voters' does is scored as a post
+  bool tapers = false;
+  int group = -1;       ///< candidates whose tracks follow one trunk share a group
+  bool chosen = false;  ///< the track that became the trunk's axis
   /// another upright column's track (a post, a neighbour's trunk): its surface is no branch
   bool other_column = false;
 };
@@ -88,7 +90,9 @@ void cutWhereJoined(std::vector<std::optional<TrackedTrunk>>* tracks);
 
 /// @brief The trunk among tracked candidates. Tracks whose lowest BASE_HEIGHT stand on one base
 /// are one trunk (a group); a group scores the median of its voters, the tracks that climb
-/// most of its height (a track that stopped at a whorl has a small shell), and is represented
+/// most of its height (a track that stopped at a whorl has a small shell), halved when none of
+/// them narrows upwards (a post's tracks cannot; a track that follows a steep scaffold beside
+/// the leader need not), and is represented
 /// by the highest voter among those that stray alike from the others: a track that follows a
 /// scaffold strays from the leader's, and one that stopped low is no judge of either.
 /// @param tracks one per start, empty where the start gave no track
