@@ -63,6 +63,14 @@ constexpr int RESUME_BACKOFF_SLICES = 2;
 constexpr double RESUME_PULL_RADII = 0.5;
 constexpr int RESUME_LINE_SLICES = 6;
 constexpr int MAX_RESUMES = 3;
+// A track that took a branch at a fork (a steep scaffold nearly as thick as the leader and
+// scanned more densely) turns off the leader's line and ends where the branch thins out, up to
+// FORK_MAX_BACKOFF_M above the fork. It is resumed from each circle that far below its end, a
+// climb along the line beneath starting FORK_SKIP_M above that circle: there a branch leaving
+// at 20 degrees or more stands 3.6 cm or more off the leader's axis, clear of a young leader
+// (their radii sum to 2-3 cm), and no longer draws the climb's first circle.
+constexpr double FORK_MAX_BACKOFF_M = 0.6;
+constexpr double FORK_SKIP_M = 0.1;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -638,31 +646,39 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 
 namespace {
 
-/// The track resumed past its last RESUME_BACKOFF_SLICES circles along the line beneath them,
-/// when that climbs more than a slice beyond its end; nothing otherwise.
-std::optional<TrackedTrunk> resumePastPull(const Points& pts, const PointIndex& index,
-                                           const TrackedTrunk& track, double threshold,
-                                           const ModelerConfig& config) {
-  const std::size_t n = track.centers.size();
-  if (n < static_cast<std::size_t>(RESUME_BACKOFF_SLICES + RESUME_LINE_SLICES))
-    return std::nullopt;
-  const std::size_t kept = n - RESUME_BACKOFF_SLICES;
-  const Points below(track.centers.begin() + (kept - RESUME_LINE_SLICES),
-                     track.centers.begin() + kept);
-  Eigen::Vector3d mean;
-  Eigen::Vector3d axis = principalAxis(below, &mean);
-  if (axis.dot(below.back() - below.front()) < 0.0)
-    axis = -axis;
-  // From the line's point level with the track's end: the pulled slices are not fitted again.
-  const Eigen::Vector3d from = mean + (track.centers.back() - mean).dot(axis) * axis;
-  const double radius = median(std::vector<double>(
-      track.radii.begin() + (kept - RESUME_LINE_SLICES), track.radii.begin() + kept));
-  if ((track.centers.back() - from).norm() <= RESUME_PULL_RADII * radius)
-    return std::nullopt;
-  TrackedTrunk more =
-      trackTrunk(pts, index, from, axis, radius, threshold, config, TRACK_MAX_MISSES, true);
+/// The line through the RESUME_LINE_SLICES circles beneath a track's first `kept` circles.
+struct LineBeneath {
+  Eigen::Vector3d point;  ///< the circles' mean
+  Eigen::Vector3d axis;   ///< unit, upwards along the track
+  double radius = 0.0;    ///< the circles' median radius
+  /// @brief The line's point level (along the axis) with p.
+  Eigen::Vector3d levelWith(const Eigen::Vector3d& p) const {
+    return point + (p - point).dot(axis) * axis;
+  }
+};
+
+LineBeneath lineBeneath(const TrackedTrunk& track, std::size_t kept) {
+  const std::size_t first = kept - RESUME_LINE_SLICES;
+  const Points below(track.centers.begin() + first, track.centers.begin() + kept);
+  LineBeneath line;
+  line.axis = principalAxis(below, &line.point);
+  if (line.axis.dot(below.back() - below.front()) < 0.0)
+    line.axis = -line.axis;
+  line.radius =
+      median(std::vector<double>(track.radii.begin() + first, track.radii.begin() + kept));
+  return line;
+}
+
+/// The track's first `kept` circles joined with a climb from `from` along the line beneath
+/// them; nothing when that climb ends within a slice of the track's end.
+std::optional<TrackedTrunk> climbOnFrom(const Points& pts, const PointIndex& index,
+                                        const TrackedTrunk& track, std::size_t kept,
+                                        const LineBeneath& line, const Eigen::Vector3d& from,
+                                        double threshold, const ModelerConfig& config) {
+  TrackedTrunk more = trackTrunk(pts, index, from, line.axis, line.radius, threshold, config,
+                                 TRACK_MAX_MISSES, true);
   if (more.centers.empty() ||
-      (more.centers.back() - track.centers.back()).dot(axis) <= config.trunk.slice_height_m)
+      (more.centers.back() - track.centers.back()).dot(line.axis) <= config.trunk.slice_height_m)
     return std::nullopt;
   TrackedTrunk joined;
   joined.centers.assign(track.centers.begin(), track.centers.begin() + kept);
@@ -672,12 +688,85 @@ std::optional<TrackedTrunk> resumePastPull(const Points& pts, const PointIndex& 
   return joined;
 }
 
+/// Whether the track's end lies off the line beneath its first `kept` circles: it was pulled
+/// or turned aside there (a track that ran out of trunk ends on its line).
+bool endsOffTheLine(const TrackedTrunk& track, const LineBeneath& line) {
+  const Eigen::Vector3d& end = track.centers.back();
+  return (end - line.levelWith(end)).norm() > RESUME_PULL_RADII * line.radius;
+}
+
+/// The track resumed past its last RESUME_BACKOFF_SLICES circles along the line beneath them,
+/// above its end, when that climbs more than a slice beyond its end; nothing otherwise.
+std::optional<TrackedTrunk> resumePastPull(const Points& pts, const PointIndex& index,
+                                           const TrackedTrunk& track, double threshold,
+                                           const ModelerConfig& config) {
+  const std::size_t n = track.centers.size();
+  if (n < static_cast<std::size_t>(RESUME_BACKOFF_SLICES + RESUME_LINE_SLICES))
+    return std::nullopt;
+  const std::size_t kept = n - RESUME_BACKOFF_SLICES;
+  const LineBeneath line = lineBeneath(track, kept);
+  if (!endsOffTheLine(track, line))
+    return std::nullopt;
+  // From the line's point level with the track's end: the pulled slices are not fitted again.
+  return climbOnFrom(pts, index, track, kept, line, line.levelWith(track.centers.back()), threshold,
+                     config);
+}
+
+/// Whether the circles from `kept` on are, by their median, no thicker than the line beneath
+/// them allows (TAPER_SWELL): the leader above a fork is not thicker than the trunk below it,
+/// whereas circles around the forks of a crown are.
+bool narrowerAbove(const TrackedTrunk& track, std::size_t kept, const LineBeneath& line) {
+  const double above = median(std::vector<double>(track.radii.begin() + kept, track.radii.end()));
+  return above <= (1.0 + TAPER_SWELL) * line.radius;
+}
+
+/// The track resumed on the leader past a fork where it took a branch: for each circle up to
+/// FORK_MAX_BACKOFF_M below its end off whose line beneath the track ends, a climb along that
+/// line from FORK_SKIP_M above it; of those that hold more circles than they drop and are
+/// narrower above, the one that climbs highest. Nothing when none does.
+std::optional<TrackedTrunk> resumePastFork(const Points& pts, const PointIndex& index,
+                                           const TrackedTrunk& track, double threshold,
+                                           const ModelerConfig& config) {
+  const double h = config.trunk.slice_height_m;
+  const int n = static_cast<int>(track.centers.size());
+  const int max_backoff =
+      std::min(n - RESUME_LINE_SLICES, static_cast<int>(std::lround(FORK_MAX_BACKOFF_M / h)));
+  std::optional<TrackedTrunk> best;
+  for (int backoff = RESUME_BACKOFF_SLICES + 1; backoff <= max_backoff; ++backoff) {
+    const std::size_t kept = n - backoff;
+    const LineBeneath line = lineBeneath(track, kept);
+    if (!endsOffTheLine(track, line))
+      continue;
+    const Eigen::Vector3d from = line.levelWith(track.centers[kept - 1]) + FORK_SKIP_M * line.axis;
+    auto resumed = climbOnFrom(pts, index, track, kept, line, from, threshold, config);
+    if (resumed && resumed->centers.size() > track.centers.size() &&
+        narrowerAbove(*resumed, kept, line) &&
+        (!best || resumed->centers.back().z() > best->centers.back().z()))
+      best = std::move(resumed);
+  }
+  return best;
+}
+
 }  // namespace
 
 TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
                               double threshold, const ModelerConfig& config) {
   for (int k = 0; k < MAX_RESUMES; ++k) {
     auto resumed = resumePastPull(pts, index, track, threshold, config);
+    if (!resumed)
+      break;
+    track = std::move(*resumed);
+  }
+  return track;
+}
+
+TrackedTrunk resumePastWhorlsAndForks(const Points& pts, const PointIndex& index,
+                                      TrackedTrunk track, double threshold,
+                                      const ModelerConfig& config) {
+  for (int k = 0; k < MAX_RESUMES; ++k) {
+    auto resumed = resumePastPull(pts, index, track, threshold, config);
+    if (!resumed)
+      resumed = resumePastFork(pts, index, track, threshold, config);
     if (!resumed)
       break;
     track = std::move(*resumed);

@@ -670,6 +670,9 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   const std::vector<double> scores = scoreTracks(index, starts, frame, tracks);
   const TrackGroups groups = groupTracks(tracks);
   const int chosen = chooseTrack(tracks, scores, groups, frame.zmin);
+  if (chosen >= 0)
+    tracks[chosen] =
+        resumePastWhorlsAndForks(pts, index, std::move(*tracks[chosen]), threshold, config);
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);
   if (chosen < 0)
     return std::nullopt;

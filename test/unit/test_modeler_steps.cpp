@@ -394,6 +394,39 @@ TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
   }
 }
 
+TEST(TrunkTracking, ATrackThatTookASteepScaffoldAtAForkIsResumedOnTheLeader) {
+  // A young leader (r 14 mm, up to 3 m) and a steep scaffold nearly as thick (r 10 mm, twice
+  // as densely scanned) that leaves it at 1.75 m at 24 degrees from the vertical, with 7 mm
+  // radial noise: at the fork the slices' centres follow the scaffold, and the track ends where
+  // it does. Resumed past the fork along the leader's line beneath, it must climb the leader.
+  Points pts;
+  Rng rng(23);
+  const double sigma = 0.007, fork_z = 1.75;
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.014, 3.0, 40000, sigma);
+  const double lean = 24.0 * M_PI / 180.0;
+  addNoisyTube(pts, rng, {0, 0, fork_z}, {std::sin(lean), 0, std::cos(lean)}, 0.010, 0.6, 16000,
+               sigma);
+  const PointIndex index(pts);
+  ModelerConfig config;
+  const TrackedTrunk track =
+      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, 0.014, 2.5 * sigma, config);
+  ASSERT_FALSE(track.centers.empty());
+  const TrackedTrunk resumed = resumePastWhorlsAndForks(pts, index, track, 2.5 * sigma, config);
+  double worst_above = 0.0;
+  for (const auto& c : resumed.centers) {
+    if (c.z() > fork_z + 0.1)
+      worst_above = std::max(worst_above, c.head<2>().norm());
+  }
+  std::printf(
+      "[ INFO ] track top %.2f m, %.0f mm off the leader; resumed top %.2f m, at most "
+      "%.1f mm off above the fork\n",
+      track.centers.back().z(), 1000 * track.centers.back().head<2>().norm(),
+      resumed.centers.back().z(), 1000 * worst_above);
+  EXPECT_GT(track.centers.back().head<2>().norm(), 0.1) << "the fixture no longer misleads";
+  EXPECT_GT(resumed.centers.back().z(), 2.8);
+  EXPECT_LT(worst_above, 0.01);
+}
+
 TEST(TrunkTracking, ATrackThatEndsAtTheTrunksTopIsNotResumed) {
   Points pts;
   Rng rng(12);

@@ -164,6 +164,22 @@ TrackedTrunk trackTrunk(const Points& pts, const PointIndex& index, const Eigen:
 TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
                               double threshold, const ModelerConfig& config);
 
+/// @brief The chosen trunk's track resumed past whorls (resumePastWhorls) and past a fork
+/// where it took a branch: a steep scaffold nearly as thick as the leader draws the circles
+/// onto itself, and the track ends where the branch does. When no whorl pulled it, the track is
+/// tried again from each of its circles up to 60 cm below its end off whose line beneath (the
+/// six circles under it) the end lies, along that line from 10 cm above the circle; a climb is
+/// kept when it holds more circles than it drops (the leader above a fork is longer than the
+/// branch) and they are no thicker than the line's by more than the taper's 10 % swell (a
+/// crown's forks are), the highest such. Up to three times. Only for the chosen track: on every
+/// track, one around clutter beside a trunk's base would climb on along its line and compete.
+/// @param track as trackTrunk() returned it, ordered bottom to top
+/// @param threshold the circle band (m), as given to trackTrunk()
+/// @return the resumed track, or `track` itself when nothing climbs further
+TrackedTrunk resumePastWhorlsAndForks(const Points& pts, const PointIndex& index,
+                                      TrackedTrunk track, double threshold,
+                                      const ModelerConfig& config);
+
 /// @brief The trunk's neighbourhood reaches this many radii from its axis ...
 constexpr double TRUNK_REACH_RADII = 3.0;
 /// @brief ... and at least this far (m) beyond its surface.
