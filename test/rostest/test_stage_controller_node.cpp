@@ -8,6 +8,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 
@@ -27,6 +28,17 @@ struct JointRecorder {
   std::size_t count() {
     std::lock_guard<std::mutex> lock(mutex);
     return states.size();
+  }
+  /// Median period (s) between the stamps of the states from index `from` on.
+  double medianPeriod(std::size_t from) {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<double> periods;
+    for (std::size_t k = std::max<std::size_t>(from, 1); k < states.size(); ++k)
+      periods.push_back((states[k].header.stamp - states[k - 1].header.stamp).toSec());
+    if (periods.empty())
+      return 0.0;
+    std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
+    return periods[periods.size() / 2];
   }
 };
 
@@ -65,12 +77,16 @@ TEST(StageControllerNode, MovesReportsFaultsAndPublishesStateAndTf) {
   EXPECT_EQ(first.response.status, Response::OK);
   EXPECT_NEAR(first.response.position, 0.2, 1e-6);
 
-  // Joint states at >= 50 Hz.
+  // Joint states at 50 Hz: the loop's period, read on the stamps (a loaded machine delays a
+  // cycle now and then, which the count over wall time shows but the median period does not),
+  // and no stall: at least 45 of the 50 a second arrive.
   const std::size_t n0 = rec.count();
   ros::WallDuration(2.0).sleep();
   const double rate = (rec.count() - n0) / 2.0;
-  EXPECT_GE(rate, 49.0);
-  std::printf("[ INFO ] joint states at %.1f Hz\n", rate);
+  const double period = rec.medianPeriod(n0);
+  std::printf("[ INFO ] joint states at %.1f Hz, median period %.1f ms\n", rate, 1000 * period);
+  EXPECT_NEAR(period, 0.020, 0.001);
+  EXPECT_GE(rate, 45.0);
   EXPECT_NEAR(rec.last().position.at(1), 0.2, 1e-6);
 
   // Soft limits are checked before anything moves.
