@@ -749,10 +749,16 @@ std::optional<TrackedTrunk> resumePastFork(const Points& pts, const PointIndex& 
 
 }  // namespace
 
-TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
-                              double threshold, const ModelerConfig& config) {
+namespace {
+
+/// The track resumed past whorls, and with `past_forks` past forks when no whorl pulled it,
+/// up to MAX_RESUMES times.
+TrackedTrunk resumeRepeatedly(const Points& pts, const PointIndex& index, TrackedTrunk track,
+                              double threshold, const ModelerConfig& config, bool past_forks) {
   for (int k = 0; k < MAX_RESUMES; ++k) {
     auto resumed = resumePastPull(pts, index, track, threshold, config);
+    if (!resumed && past_forks)
+      resumed = resumePastFork(pts, index, track, threshold, config);
     if (!resumed)
       break;
     track = std::move(*resumed);
@@ -760,18 +766,17 @@ TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, Tracke
   return track;
 }
 
+}  // namespace
+
+TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, TrackedTrunk track,
+                              double threshold, const ModelerConfig& config) {
+  return resumeRepeatedly(pts, index, std::move(track), threshold, config, false);
+}
+
 TrackedTrunk resumePastWhorlsAndForks(const Points& pts, const PointIndex& index,
                                       TrackedTrunk track, double threshold,
                                       const ModelerConfig& config) {
-  for (int k = 0; k < MAX_RESUMES; ++k) {
-    auto resumed = resumePastPull(pts, index, track, threshold, config);
-    if (!resumed)
-      resumed = resumePastFork(pts, index, track, threshold, config);
-    if (!resumed)
-      break;
-    track = std::move(*resumed);
-  }
-  return track;
+  return resumeRepeatedly(pts, index, std::move(track), threshold, config, true);
 }
 
 double estimateNoiseSigma(const Points& pts, const Centerline& line,

@@ -1,4 +1,4 @@
-// The stage_controller node against the Aerotech emulator: joint states at >= 50 Hz, moves
+// The stage_controller node against the Aerotech emulator: joint states at 50 Hz, moves
 // with soft limits, an axis fault mid-move reported and recovered from, and the tf chain.
 #include <dormant_tree_modeling/MoveAxis.h>
 #include <gtest/gtest.h>
@@ -7,6 +7,8 @@
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+
+#include "dormant_tree_modeling/common/statistics.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,10 +37,7 @@ struct JointRecorder {
     std::vector<double> periods;
     for (std::size_t k = std::max<std::size_t>(from, 1); k < states.size(); ++k)
       periods.push_back((states[k].header.stamp - states[k - 1].header.stamp).toSec());
-    if (periods.empty())
-      return 0.0;
-    std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
-    return periods[periods.size() / 2];
+    return periods.empty() ? 0.0 : dormant_tree_modeling::median(periods);
   }
 };
 
