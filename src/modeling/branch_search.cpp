@@ -213,10 +213,64 @@ BranchSearch::BranchSearch(const BranchContext& context, const BranchCandidates&
 void BranchSearch::run(const std::vector<std::vector<int>>& clusters) {
   for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
     work_.push_back({*it, std::nullopt});
+  searchWorkList();
+  const std::size_t steep_from = branches_.size();
+  const ModelerConfig& config = context_.config;
+  if (config.fit.constrain && config.branches.steep_search)
+    searchSteep();
+  reportTurnedDown(steep_from);
+}
+
+void BranchSearch::searchWorkList() {
   while (!work_.empty()) {
     const Candidate candidate = std::move(work_.back());
     work_.pop_back();
     examine(candidate);
+  }
+}
+
+/// Steep scaffolds (60-75 deg from the radial) leave the trunk side by side and fuse into
+/// clusters that are not one long directed line, so the first search judges them by the
+/// radial bound; their halves then fail too. Once every other branch is out, what was turned
+/// down is clustered again, the fused pieces whole, and searched for steep fits alone: a
+/// shallower fit was judged already, and a steep one can no longer take another branch's
+/// points.
+void BranchSearch::searchSteep() {
+  std::vector<int> left;
+  for (const TurnedDown& t : turned_down_)
+    left.insert(left.end(), t.members.begin(), t.members.end());
+  std::sort(left.begin(), left.end());
+  left.erase(std::unique(left.begin(), left.end()), left.end());
+  Points left_pts;
+  for (const int k : left)
+    left_pts.push_back(candidates_.pts[k]);
+  const BranchConfig& b = context_.config.branches;
+  auto clusters = euclideanClusters(left_pts, b.cluster_tolerance_m, b.min_points);
+  steep_pass_ = true;
+  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it) {
+    for (int& k : *it)
+      k = left[k];
+    work_.push_back({std::move(*it), std::nullopt});
+  }
+  searchWorkList();
+  steep_pass_ = false;
+}
+
+/// Every candidate turned down is reported, but for one that gave most of its points to a
+/// steep branch.
+void BranchSearch::reportTurnedDown(std::size_t steep_from) {
+  if (!rejected_)
+    return;
+  std::vector<int> taken;
+  for (std::size_t i = steep_from; i < branches_.size(); ++i)
+    taken.insert(taken.end(), branches_[i].inliers.begin(), branches_[i].inliers.end());
+  std::sort(taken.begin(), taken.end());
+  for (const TurnedDown& t : turned_down_) {
+    const auto in_steep = std::count_if(t.members.begin(), t.members.end(), [&](int k) {
+      return std::binary_search(taken.begin(), taken.end(), candidates_.index[k]);
+    });
+    if (2 * in_steep <= static_cast<std::ptrdiff_t>(t.members.size()))
+      rejected_->push_back(t.as_rejected);
   }
 }
 
@@ -386,7 +440,7 @@ std::optional<BranchSearch::Direction> BranchSearch::direction(const NearPart& n
   radial.normalize();
   if (axis.dot(radial) < 0.0)
     axis = -axis;
-  const bool elongated = spread(2) > STEEP_ELONGATION * spread(1);
+  const bool elongated = steep_pass_ || spread(2) > STEEP_ELONGATION * spread(1);
   const double max_angle =
       (elongated ? config.branches.max_steep_angle_deg : config.branches.max_radial_angle_deg) *
       DEG;
@@ -467,7 +521,12 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidat
   const bool off_ray = candidate.ray && lineAngle(fit.axis, *candidate.ray) > RAY_AGREEMENT;
   if (off_ray)
     return Verdict{BranchRejection::OFF_ITS_RAY, true};
-  if (angleBetween(fit.axis, guess.radial) > guess.max_angle || sideways)
+  const double radial_angle = angleBetween(fit.axis, guess.radial);
+  const bool judged_before =
+      steep_pass_ && radial_angle <= config.branches.max_radial_angle_deg * DEG;
+  if (judged_before)
+    return Verdict{BranchRejection::NOT_RADIAL, false};
+  if (radial_angle > guess.max_angle || sideways)
     return Verdict{BranchRejection::NOT_RADIAL, true};
   if (angleBetween(fit.axis, seg.axis) > (90.0 - config.branches.min_elevation_deg) * DEG)
     return Verdict{BranchRejection::POINTS_DOWN, true};
@@ -546,9 +605,10 @@ void BranchSearch::reject(const Candidate& candidate, int segment, Verdict verdi
     if (splitAlongRay(candidate, cluster_pts, segment) || splitInHalves(candidate, cluster_pts))
       return;
   }
-  if (rejected_) {
-    rejected_->push_back(rejection(candidates_.pts, candidate.members, verdict.reason,
-                                   could_split && !budgetLeft()));
+  if (!steep_pass_) {
+    turned_down_.push_back(
+        {candidate.members, rejection(candidates_.pts, candidate.members, verdict.reason,
+                                      could_split && !budgetLeft())});
   }
 }
 

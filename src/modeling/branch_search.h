@@ -80,7 +80,9 @@ class BranchSearch {
   BranchSearch(const BranchContext& context, const BranchCandidates& candidates,
                std::vector<RejectedBranch>* rejected);
 
-  /// @brief Searches the clusters (indices into the candidates), the last first.
+  /// @brief Searches the clusters (indices into the candidates), the last first. With
+  /// fit.constrain and branches.steep_search, what was turned down is then clustered again and
+  /// searched for steep branches only (searchSteep), and only then reported as turned down.
   void run(const std::vector<std::vector<int>>& clusters);
 
   /// @brief The fits that reach the trunk surface, in the order found.
@@ -105,12 +107,20 @@ class BranchSearch {
     BranchRejection reason;
     bool splittable;
   };
+  // A candidate turned down, kept with its members until the steep search has seen them.
+  struct TurnedDown {
+    std::vector<int> members;  // indices into the candidates
+    RejectedBranch as_rejected;
+  };
   struct Direction {
     Eigen::Vector3d radial;  // from the trunk axis through the near part, level with it
     Eigen::Vector3d axis;    // the guess the fit starts from
     double max_angle;        // rad, of the fit's axis from the radial
   };
 
+  void searchWorkList();
+  void searchSteep();
+  void reportTurnedDown(std::size_t steep_from);
   void examine(const Candidate& candidate);
   NearPart nearPart(const std::vector<int>& cluster, double reach) const;
   bool refitAtFork(const Candidate& candidate, const Cylinder& seg, const Direction& guess,
@@ -153,6 +163,10 @@ class BranchSearch {
   std::uint64_t refit_stream_ = 0;
   std::vector<BranchFit> branches_;
   std::vector<CutFit> cut_;
+  std::vector<TurnedDown> turned_down_;
+  // In the steep search every candidate keeps its own direction up to
+  // branches.max_steep_angle_deg, and only fits steeper than branches.max_radial_angle_deg pass.
+  bool steep_pass_ = false;
 };
 
 }  // namespace detail

@@ -181,6 +181,9 @@ void addBranchSearch(ConfigTable<ModelerConfig>& t) {
            "Two pieces of one curved branch (one centre inside the other's tube, axes within "
            "45 deg) are one, the longer kept.")
       .formerly("branch_merge_curved")
+      .add("branches.steep_search", &B::steep_search,
+           "What the search turned down is clustered again and searched for steep branches "
+           "alone (between max_radial_angle_deg and max_steep_angle_deg from the radial).")
       .add("branches.min_relative_points", &B::min_relative_points, 0.0, 1.0,
            "Detections with fewer inliers than this share of the tree's median are dropped; "
            "0: off.")
@@ -264,6 +267,7 @@ ModelerConfig ModelerConfig::paper() {
   c.branches.ray_split = false;
   c.branches.keep_cut_off = false;
   c.branches.merge_curved = false;
+  c.branches.steep_search = false;
   c.branches.min_relative_points = 0.0;
   return c;
 }

@@ -988,6 +988,42 @@ TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
     EXPECT_LT(b.cylinder.axis.dot(steep), std::cos(10.0 * M_PI / 180.0));
 }
 
+TEST(BranchModel, AShortThickSteepScaffoldIsFoundByTheSteepSearch) {
+  // A scaffold 24 deg from the trunk, 30 mm in radius on a 50 mm trunk and 0.4 m long: its
+  // points in the shell are not four times longer than wide, so the first search judges it by
+  // the radial bound and its halves fail too. The steep search takes it whole.
+  Points pts;
+  addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.05, 2.0);  // trunk
+  const std::size_t trunk_points = pts.size();
+  const double elevation = 66.0 * M_PI / 180.0;
+  const Eigen::Vector3d steep(std::cos(elevation), 0.0, std::sin(elevation));
+  addCylinder(pts, Eigen::Vector3d(0.02, 0, 0.8), steep, 0.03, 0.4);
+  std::vector<int> region(trunk_points);
+  std::iota(region.begin(), region.end(), 0);
+  ModelerConfig config;
+  config.noise.sigma_m = 0.002;
+  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, config);
+  const PointIndex index(pts);
+  std::vector<RejectedBranch> rejected;
+  const auto found = modelBranches(pts, index, trunk, region, config, &rejected);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_GT(found[0].cylinder.axis.dot(steep), std::cos(2.0 * M_PI / 180.0));
+  EXPECT_NEAR(found[0].cylinder.radius, 0.03, 0.004);
+  // What the steep search took is not reported as turned down.
+  for (const auto& r : rejected)
+    EXPECT_NE(r.reason, BranchRejection::NOT_RADIAL) << r.points << " points";
+
+  config.branches.steep_search = false;
+  rejected.clear();
+  const auto without = modelBranches(pts, index, trunk, region, config, &rejected);
+  for (const auto& b : without)
+    EXPECT_LT(b.cylinder.axis.dot(steep), std::cos(5.0 * M_PI / 180.0));
+  int not_radial = 0;
+  for (const auto& r : rejected)
+    not_radial += r.reason == BranchRejection::NOT_RADIAL;
+  EXPECT_GT(not_radial, 0);
+}
+
 TEST(BranchModel, TwoBranchesFromOneCrotchNeedTheSearchBudget) {
   // Two primaries leave from one point 30 deg apart: near the trunk they are one cluster, so
   // the second is found only in what is left after the first is taken out.

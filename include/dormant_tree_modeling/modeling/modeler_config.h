@@ -109,6 +109,11 @@ struct BranchConfig {
   /// Two detections that are pieces of one curved branch (one centre inside the other's tube,
   /// axes within 45 deg) are one; the longer is kept. Off: only near-parallel duplicates merge.
   bool merge_curved = true;
+  /// What the search turned down is clustered again, once every other branch is out, and
+  /// searched for steep branches alone (more than max_radial_angle_deg and at most
+  /// max_steep_angle_deg from the radial): steep scaffolds leave the trunk side by side and
+  /// fuse into clusters that are not one directed line.
+  bool steep_search = true;
   /// A detection with fewer inliers than this fraction of the median over the tree's
   /// detections is dropped (a shoot on a primary, a neighbour's branch tip, a streak of mixed
   /// pixels); 0: off. Needs at least 4 detections.
