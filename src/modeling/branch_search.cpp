@@ -241,17 +241,10 @@ void BranchSearch::searchSteep() {
     left.insert(left.end(), t.members.begin(), t.members.end());
   std::sort(left.begin(), left.end());
   left.erase(std::unique(left.begin(), left.end()), left.end());
-  Points left_pts;
-  for (const int k : left)
-    left_pts.push_back(candidates_.pts[k]);
-  const BranchConfig& b = context_.config.branches;
-  auto clusters = euclideanClusters(left_pts, b.cluster_tolerance_m, b.min_points);
+  auto clusters = clustersOf(left);
   steep_pass_ = true;
-  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it) {
-    for (int& k : *it)
-      k = left[k];
+  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it)
     work_.push_back({std::move(*it), std::nullopt});
-  }
   searchWorkList();
   steep_pass_ = false;
 }
@@ -672,18 +665,23 @@ std::vector<int> BranchSearch::searchRest(const std::vector<int>& cluster, const
 
 /// Parts of a cluster are clustered again: a part may have fallen apart.
 void BranchSearch::pushParts(const std::vector<int>& rest) {
-  Points rest_pts;
-  for (const int k : rest)
-    rest_pts.push_back(candidates_.pts[k]);
-  const ModelerConfig& config = context_.config;
-  for (const auto& part : euclideanClusters(rest_pts, config.branches.cluster_tolerance_m,
-                                            config.branches.min_points)) {
-    std::vector<int> mapped;
-    for (const int k : part)
-      mapped.push_back(rest[k]);
-    work_.push_back({std::move(mapped), std::nullopt});
+  for (auto& part : clustersOf(rest)) {
+    work_.push_back({std::move(part), std::nullopt});
     ++extractions_;
   }
+}
+
+std::vector<std::vector<int>> BranchSearch::clustersOf(const std::vector<int>& members) const {
+  Points pts;
+  for (const int k : members)
+    pts.push_back(candidates_.pts[k]);
+  const BranchConfig& b = context_.config.branches;
+  auto clusters = euclideanClusters(pts, b.cluster_tolerance_m, b.min_points);
+  for (auto& cluster : clusters) {
+    for (int& k : cluster)
+      k = members[k];
+  }
+  return clusters;
 }
 
 }  // namespace detail

@@ -151,6 +151,9 @@ class BranchSearch {
   bool splitInHalves(const Candidate& candidate, const Points& cluster_pts);
   std::vector<int> searchRest(const std::vector<int>& cluster, const Cylinder& found);
   void pushParts(const std::vector<int>& rest);
+  // Euclidean clusters (branches.cluster_tolerance_m, branches.min_points) of some
+  // candidates, as indices into the candidates.
+  std::vector<std::vector<int>> clustersOf(const std::vector<int>& members) const;
   bool budgetLeft() const;
 
   const BranchContext context_;  // a copy: callers pass a temporary (it holds references only)

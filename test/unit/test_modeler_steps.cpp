@@ -959,6 +959,17 @@ TEST(BranchModel, OppositeThinBranchesAcrossTheRowAreNoWire) {
   EXPECT_EQ(wires(rejected), 4);
 }
 
+/// The trunk of the steep-scaffold scenes: the first trunk_points points, a vertical 5 cm
+/// cylinder from z 0 to 2 m, modeled at 2 mm noise with the default parameters.
+test::BuiltTrunk buildScaffoldTrunk(const Points& pts, std::size_t trunk_points) {
+  test::BuiltTrunk b;
+  b.region.resize(trunk_points);
+  std::iota(b.region.begin(), b.region.end(), 0);
+  b.config.noise.sigma_m = 0.002;
+  b.trunk = modelTrunk(pts, b.region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, b.config);
+  return b;
+}
+
 TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
   // A central leader's scaffold leaving 62 deg above the horizontal (28 deg from the trunk):
   // its points in the shell are a long directed cluster, and its axis is its own, not the
@@ -968,11 +979,7 @@ TEST(BranchModel, ASteepScaffoldKeepsItsOwnDirection) {
   const std::size_t trunk_points = pts.size();
   const Eigen::Vector3d steep(std::cos(62.0 * M_PI / 180.0), 0.0, std::sin(62.0 * M_PI / 180.0));
   addCylinder(pts, Eigen::Vector3d(0.05, 0, 0.7), steep, 0.022, 1.0);
-  std::vector<int> region(trunk_points);
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise.sigma_m = 0.002;
-  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, config);
+  auto [region, config, trunk] = buildScaffoldTrunk(pts, trunk_points);
   const auto branches = modelBranches(pts, PointIndex(pts), trunk, region, config);
   ASSERT_EQ(branches.size(), 1u);
   EXPECT_GT(branches[0].cylinder.axis.dot(steep), std::cos(5.0 * M_PI / 180.0));
@@ -998,11 +1005,7 @@ TEST(BranchModel, AShortThickSteepScaffoldIsFoundByTheSteepSearch) {
   const double elevation = 66.0 * M_PI / 180.0;
   const Eigen::Vector3d steep(std::cos(elevation), 0.0, std::sin(elevation));
   addCylinder(pts, Eigen::Vector3d(0.02, 0, 0.8), steep, 0.03, 0.4);
-  std::vector<int> region(trunk_points);
-  std::iota(region.begin(), region.end(), 0);
-  ModelerConfig config;
-  config.noise.sigma_m = 0.002;
-  const TrunkModel trunk = modelTrunk(pts, region, {{0, 0, 0}, {0, 0, 2.0}}, 0.05, config);
+  auto [region, config, trunk] = buildScaffoldTrunk(pts, trunk_points);
   const PointIndex index(pts);
   std::vector<RejectedBranch> rejected;
   const auto found = modelBranches(pts, index, trunk, region, config, &rejected);
