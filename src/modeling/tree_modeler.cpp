@@ -437,7 +437,8 @@ ModelResult TreeModeler::model(const Points& input) const {
   // that picks a surface out of clutter.
   const double column_band =
       std::max(config_.fit.cylinder_threshold_m, noiseBand(trunk.search_sigma));
-  const std::vector<char> on_columns = pointsOnColumns(pts, columns, column_band);
+  const std::vector<char> on_columns =
+      pointsOnColumns(pts, columns, TrackedTrunk{region.axis, region.radii}, column_band);
   result.column_points = static_cast<int>(std::count(on_columns.begin(), on_columns.end(), 1));
   const auto branches =
       modelBranches(pts, index, trunk, region.points, config_, &result.rejected_branches,

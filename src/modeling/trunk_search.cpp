@@ -28,13 +28,18 @@ constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
 // A track whose top third is at least this share of its bottom third's radius does not taper.
-// A group of tracks none of which tapers is a trellis post or a pole, scored at POLE_WEIGHT (a
-// tree's trunk tapers; one post beside a tree gathers the tree's branches in its shell and
-// outscored the trunk on two test trees). One tapering track is enough: a track that follows
-// a steep scaffold beside the leader grows with it and no longer tapers, where a post's tracks
-// cannot narrow.
+// A group all of whose tracks neither taper nor vary in radius (POLE_RADIUS_SPREAD) is a
+// trellis post or a pole, scored at POLE_WEIGHT (one post beside a tree gathers the tree's
+// branches in its shell and outscored the trunk on two test trees). One track that is no pole
+// is enough: a track that follows a steep scaffold beside the leader grows with it and no
+// longer tapers, where a post's tracks cannot narrow.
 constexpr double POLE_TAPER = 0.9;
 constexpr double POLE_WEIGHT = 0.5;
+// A post's circles keep one radius: over a track's lower two thirds (above them a post's track
+// can run onto the leader of a tree leaning on the post) their median absolute deviation is
+// at most this share of their median. A trunk's taper and whorls vary it by more; at
+// 12 mm of range noise a thin trunk's taper is lost in the noise, but not its variation.
+constexpr double POLE_RADIUS_SPREAD = 0.025;
 constexpr double RETRY_WIDTH = 1.6;     // first circle / start radius above which a low track
                                         // is retried
 constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
@@ -215,15 +220,19 @@ std::optional<std::size_t> joinsOnto(const TrackedTrunk& a, const TrackedTrunk& 
   return std::nullopt;
 }
 
-/// Whether track b keeps clear of track a's surface: at each of b's circles within a's span
-/// the gap between their surfaces exceeds `band` (m).
-bool keepsClear(const TrackedTrunk& a, const TrackedTrunk& b, double band) {
+/// Whether track b keeps clear of track a's surface at most heights: at more than half of b's
+/// circles within a's span the gap between their surfaces exceeds `band` (m). A post that a
+/// leaning tree touches is clear of it below and above; a track that follows the trunk is not.
+bool keepsMostlyClear(const TrackedTrunk& a, const TrackedTrunk& b, double band) {
+  int shared = 0, clear = 0;
   for (std::size_t k = 0; k < b.centers.size(); ++k) {
     const auto gap = surfaceGapAt(a, b.centers[k]);
-    if (gap && *gap - b.radii[k] <= band)
-      return false;
+    if (!gap)
+      continue;
+    ++shared;
+    clear += *gap - b.radii[k] > band ? 1 : 0;
   }
-  return true;
+  return 2 * clear > shared || shared == 0;
 }
 
 /// Whether a track narrows upwards (POLE_TAPER). One too short to tell counts as tapering.
@@ -234,6 +243,25 @@ bool tapers(const TrackedTrunk& t) {
   const std::vector<double> lower(t.radii.begin(), t.radii.begin() + third);
   const std::vector<double> upper(t.radii.end() - third, t.radii.end());
   return median(upper) < POLE_TAPER * median(lower);
+}
+
+/// Whether a track keeps one radius (POLE_RADIUS_SPREAD) over its lower two thirds. One too
+/// short to tell does not.
+bool keepsOneRadius(const TrackedTrunk& t) {
+  const std::size_t third = t.radii.size() / 3;
+  if (third < 3)
+    return false;
+  const std::vector<double> lower(t.radii.begin(), t.radii.end() - third);
+  const double middle = median(lower);
+  std::vector<double> deviation;
+  for (const double r : lower)
+    deviation.push_back(std::abs(r - middle));
+  return median(std::move(deviation)) <= POLE_RADIUS_SPREAD * middle;
+}
+
+/// Whether a track reads as a post or pole: it neither tapers nor varies in radius.
+bool isPole(const TrackedTrunk& t) {
+  return !tapers(t) && keepsOneRadius(t);
 }
 
 /// Branch points in the shell around a track, weighted down for a track far from the crop's
@@ -351,21 +379,21 @@ int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const
 
 /// A group's score: the median of its voting tracks' (only those that climb most of the
 /// group's height vote, since a track that stopped at a whorl low on the trunk has a small
-/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when none tapers.
-/// Negative when it has no voter.
+/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when every one reads as
+/// a pole. Negative when it has no voter.
 double groupScore(const std::vector<std::optional<TrackedTrunk>>& tracks,
                   const std::vector<double>& scores, const std::vector<char>& voters) {
   std::vector<double> member_scores;
-  bool tapering = false;
+  bool pole = true;
   for (std::size_t k = 0; k < tracks.size(); ++k) {
     if (!voters[k])
       continue;
     member_scores.push_back(scores[k]);
-    tapering = tapering || tapers(*tracks[k]);
+    pole = pole && isPole(*tracks[k]);
   }
   if (member_scores.empty())
     return -1.0;
-  return (tapering ? 1.0 : POLE_WEIGHT) * median(std::move(member_scores));
+  return (pole ? POLE_WEIGHT : 1.0) * median(std::move(member_scores));
 }
 
 /// The best-scoring group's representative (groupScore), or -1.
@@ -404,7 +432,7 @@ std::vector<TrunkCandidate> candidateReport(const std::vector<TrunkStart>& start
     r.top = tracks[k]->centers.back().z();
     r.median_radius = median(tracks[k]->radii);
     r.score = scores[k];
-    r.tapers = tapers(*tracks[k]);
+    r.pole = isPole(*tracks[k]);
     r.group = groups[k];
     r.chosen = static_cast<int>(k) == chosen;
   }
@@ -588,7 +616,7 @@ std::vector<TrunkStart> standingStarts(const std::vector<TrunkStart>& starts,
 }
 
 /// The representatives of the groups other than the chosen track's whose tracks stand and keep
-/// clear of it (trackBestTrunk's `columns`): their indices.
+/// mostly clear of it (trackBestTrunk's `columns`): their indices.
 std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tracks,
                               const std::vector<TrunkStart>& starts, const TrackGroups& g,
                               int chosen, double band, const SearchFrame& frame) {
@@ -601,8 +629,8 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
     if (k < 0)
       continue;
     if (stands(*tracks[k], starts[k], frame.zmax) &&
-        keepsClear(*tracks[chosen], *tracks[k], band) &&
-        keepsClear(*tracks[k], *tracks[chosen], band))
+        keepsMostlyClear(*tracks[chosen], *tracks[k], band) &&
+        keepsMostlyClear(*tracks[k], *tracks[chosen], band))
       out.push_back(k);
   }
   return out;
@@ -685,11 +713,14 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
 }
 
 std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
-                                  double band) {
+                                  const TrackedTrunk& trunk, double band) {
   std::vector<char> on(pts.size(), 0);
   if (columns.empty())
     return on;
   parallelFor(static_cast<int>(pts.size()), [&](int i) {
+    const auto on_trunk = surfaceGapAt(trunk, pts[i]);
+    if (on_trunk && *on_trunk <= band)
+      return;
     for (const auto& column : columns) {
       const auto gap = surfaceGapAt(column, pts[i]);
       if (gap && *gap <= band) {

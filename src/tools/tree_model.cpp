@@ -120,9 +120,9 @@ int main(int argc, char** argv) {
                   << c.start.x() << ", " << c.start.y() << ", " << c.start.z() << ") r "
                   << 1000.0 * c.start_radius << " mm: " << c.slices << " circles, z " << c.bottom
                   << ".." << c.top << ", median r " << 1000.0 * c.median_radius << " mm, score "
-                  << c.score << (c.slices > 0 && !c.tapers ? " (no taper)" : "") << ", trunk "
-                  << c.group << (c.chosen ? "  <- trunk" : "")
-                  << (c.other_column ? "  <- another column" : "") << "\n";
+                  << c.score << (c.slices > 0 && c.pole ? " (pole)" : "") << ", trunk " << c.group
+                  << (c.chosen ? "  <- trunk" : "") << (c.other_column ? "  <- another column" : "")
+                  << "\n";
       }
       std::cerr << "  " << result.column_points
                 << " points on other upright columns left out of the branch search\n";

@@ -454,11 +454,12 @@ Cluster flatFootCluster() {
 
 /// trackBestTrunk with the default config, Algorithm 2's path starting at cluster 1 (a post).
 std::optional<TrackedTrunk> trackFromPost(const Points& pts, const std::vector<Cluster>& clusters,
-                                          std::vector<TrunkCandidate>* report) {
+                                          std::vector<TrunkCandidate>* report,
+                                          std::vector<TrackedTrunk>* columns = nullptr) {
   TrunkPath path;
   path.trunk = {1};
   const PointIndex index(pts);
-  return trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, report);
+  return trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, report, columns);
 }
 
 TEST(TrunkSearch, ADenseColumnAwayFromTheStartsIsAStart) {
@@ -524,21 +525,19 @@ TEST(TrunkSearch, APostBesideTheTreeIsAnotherColumnAndItsPointsAreFlagged) {
   std::vector<Cluster> clusters;
   int tree_points = 0;
   treeAndPost(&pts, &clusters, &tree_points);
-  TrunkPath path;
-  path.trunk = {1};
   std::vector<TrunkCandidate> report;
   std::vector<TrackedTrunk> columns;
-  const PointIndex index(pts);
-  ASSERT_TRUE(trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, &report, &columns));
+  const auto best = trackFromPost(pts, clusters, &report, &columns);
+  ASSERT_TRUE(best);
   ASSERT_EQ(columns.size(), 1u);
   for (const auto& c : columns[0].centers)
     EXPECT_LT((c.head<2>() - Eigen::Vector2d(0.5, 0.3)).norm(), 0.01) << "at z " << c.z();
   EXPECT_GT(columns[0].centers.back().z(), 1.2);
-  const auto on = pointsOnColumns(pts, columns, 0.01);
+  const auto on = pointsOnColumns(pts, columns, *best, 0.01);
   EXPECT_EQ(std::count(on.begin(), on.begin() + tree_points, 1), 0);
   const auto post_points = static_cast<double>(pts.size() - tree_points);
   EXPECT_GT(std::count(on.begin() + tree_points, on.end(), 1), 0.9 * post_points);
-  const auto none = pointsOnColumns(pts, {}, 0.01);
+  const auto none = pointsOnColumns(pts, {}, *best, 0.01);
   EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
 }
 
@@ -651,6 +650,35 @@ TEST(TrunkSearch, ATreeWhoseTracksGrewOnSteepScaffoldsOutscoresAPost) {
             3);
 }
 
+TEST(TrunkSearch, ANoisyTrunkThatReadsUntaperedOutscoresAPostItLeansOn) {
+  // Seed 132's steep-scaffold tree at 6 and 12 mm: its trunk leans 0.47 m onto a post (r 44
+  // mm). Its track's circles read 21 +- 4 mm from the base up, and 28 mm beside the post at
+  // the top: it does not narrow. The post's tracks hold 45 mm up to the post's top, then run
+  // onto the leader. Both read untapered, both were scored as posts, and the post, whose shell
+  // holds the leaning crown, was the trunk (F1 36-45 %). The trunk's radius varies; the post's
+  // does not.
+  const auto lean = [](double z) { return Eigen::Vector2d(0.16 * z, 0.0); };
+  const auto post = [](double z) {
+    return z < 3.25 ? Eigen::Vector2d(0.47, 0.14) : Eigen::Vector2d(0.53, 0.11);
+  };
+  std::vector<std::optional<TrackedTrunk>> tracks = {trackAlong(2.8, lean), trackAlong(3.7, post),
+                                                     trackAlong(3.7, post)};
+  for (std::size_t k = 0; k < tracks[0]->radii.size(); ++k) {
+    tracks[0]->radii[k] =
+        tracks[0]->centers[k].z() < 2.4 ? 0.021 + 0.004 * std::sin(2.3 * k) : 0.028;
+  }
+  for (int t = 1; t <= 2; ++t) {
+    for (std::size_t k = 0; k < tracks[t]->radii.size(); ++k)
+      tracks[t]->radii[k] = tracks[t]->centers[k].z() < 3.25 ? 0.045 : 0.02;
+  }
+  std::vector<int> groups;
+  EXPECT_EQ(chooseTrunkTrack(tracks, {0.55, 0.74, 0.74}, 0.1, &groups), 0);
+  EXPECT_EQ(groups, (std::vector<int>{0, 1, 1}));
+  // A trunk whose circles kept one radius would read as a post, and lose.
+  std::fill(tracks[0]->radii.begin(), tracks[0]->radii.end(), 0.021);
+  EXPECT_EQ(groups[chooseTrunkTrack(tracks, {0.55, 0.74, 0.74}, 0.1)], 1);
+}
+
 /// A trunk from (0, 0) leaning 0.45 m towards -x over 3 m and narrowing from 30 to 10 mm,
 /// with a branch every 0.3 m from 0.8 m; a post (r 55 mm) at (-0.55, 0.14); a neighbour's
 /// trunk at (-1.1, 0) whose branches reach over to the post. The crop spans both trees, its
@@ -702,12 +730,50 @@ TEST(TrunkSearch, ALeaningTreeIsNearerTheCropCentreThanItsBase) {
   const auto best = trackBestTrunk(pts, index, clusters, path, ModelerConfig{}, &report);
   for (const auto& c : report) {
     std::printf("[ INFO ] start (%.2f, %.2f) r %.1f mm: %d circles, score %.0f%s%s\n", c.start.x(),
-                c.start.y(), 1000 * c.start_radius, c.slices, c.score,
-                c.tapers ? "" : " (no taper)", c.chosen ? " <- trunk" : "");
+                c.start.y(), 1000 * c.start_radius, c.slices, c.score, c.pole ? " (pole)" : "",
+                c.chosen ? " <- trunk" : "");
   }
   ASSERT_TRUE(best);
   EXPECT_LT(best->centers.front().head<2>().norm(), 0.05);
   EXPECT_GT(best->centers.back().z(), 2.5);
+}
+
+TEST(TrunkSearch, APostATreeLeansOnIsAColumnBesideTheirContact) {
+  // Seed 132's crooked leader at 3 mm: the trunk leans onto its post and touches it over its
+  // top 30 cm. The post kept clear of the trunk at most heights, not at all, so it was no
+  // column, and 10 branch fits lay on it. Here a trunk from (0, 0) leans 0.3 m over 3 m,
+  // narrowing from 25 to 12 mm, and touches a post (r 45 mm) at (0.3, 0.055) from 2.75 m up. The
+  // post is a column; its points are flagged, except those as near the trunk's surface.
+  Points pts;
+  const Eigen::Vector3d lean(0.1, 0.0, 1.0);
+  const int segments = 10;
+  for (int k = 0; k < segments; ++k)
+    addCylinder(pts, lean * (0.3 * k), lean, 0.025 - 0.013 * k / (segments - 1.0),
+                0.3 * lean.norm());
+  for (int b = 0; b < 6; ++b) {
+    const double z = 0.7 + 0.3 * b, phi = M_PI / 2 + 0.5 * b;
+    addCylinder(pts, lean * z, {std::cos(phi), std::sin(phi), 0.4}, 0.01, 0.4);
+  }
+  const int tree_points = static_cast<int>(pts.size());
+  addCylinder(pts, {0.3, 0.055, 0.0}, {0, 0, 1}, 0.045, 3.2);
+  std::vector<Cluster> clusters(2);
+  for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+    if (pts[i].z() < 0.3)
+      clusters[i < tree_points ? 0 : 1].members.push_back(i);
+  }
+  for (auto& c : clusters)
+    updateCluster(pts, c);
+  std::vector<TrunkCandidate> report;
+  std::vector<TrackedTrunk> columns;
+  const auto best = trackFromPost(pts, clusters, &report, &columns);
+  ASSERT_TRUE(best);
+  EXPECT_LT(best->centers.front().head<2>().norm(), 0.02);
+  ASSERT_EQ(columns.size(), 1u);
+  EXPECT_LT((columns[0].centers.front().head<2>() - Eigen::Vector2d(0.3, 0.055)).norm(), 0.01);
+  const auto on = pointsOnColumns(pts, columns, *best, 0.01);
+  const auto post_points = static_cast<double>(pts.size() - tree_points);
+  EXPECT_GT(std::count(on.begin() + tree_points, on.end(), 1), 0.9 * post_points);
+  EXPECT_LT(std::count(on.begin(), on.begin() + tree_points, 1), 0.01 * tree_points);
 }
 
 TEST(TrunkSearch, ATrackThatRanOntoAPostIsCutWhereItJoinedIt) {
@@ -881,12 +947,14 @@ TEST(BranchModel, PointsOnAnotherColumnAreNoCandidates) {
   }
   auto [region, config, trunk] = buildTrunk(pts, trunk_points);
   const PointIndex index(pts);
-  TrackedTrunk post;
+  TrackedTrunk post, trunk_track;
   for (int k = 0; k <= 30; ++k) {
     post.centers.emplace_back(-0.45, 0.14, 0.05 * k);
     post.radii.push_back(0.043);
+    trunk_track.centers.emplace_back(0.0, 0.0, 0.05 * k);
+    trunk_track.radii.push_back(0.03);
   }
-  const auto on = pointsOnColumns(pts, {post}, 0.03);
+  const auto on = pointsOnColumns(pts, {post}, trunk_track, 0.03);
   const auto flagged = [&](std::size_t from, std::size_t to) {
     return std::count(on.begin() + from, on.begin() + to, 1);
   };

@@ -21,8 +21,9 @@ struct TrunkCandidate {
   double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
   double median_radius = 0.0;      ///< of the track's circles (m)
   double score = -1.0;             ///< branch points around it, weighted
-  /// its radius narrows upwards; a group none of whose voters' does is scored as a post
-  bool tapers = false;
+  /// its radius neither narrows upwards nor varies: a group all of whose voters read so is
+  /// scored as a post
+  bool pole = false;
   int group = -1;       ///< candidates whose tracks follow one trunk share a group
   bool chosen = false;  ///< the track that became the trunk's axis
   /// another upright column's track (a post, a neighbour's trunk): its surface is no branch
@@ -63,7 +64,8 @@ std::vector<TrunkStart> densityColumnStarts(const Points& pts, double zmin,
 /// @param columns if given, filled with the other upright columns the search tracked (a post,
 ///        a neighbour's trunk): each other group's representative whose track stands (climbs
 ///        half the clusters' height above its start) and keeps clear of the trunk's surface by
-///        more than the tracking band at every height they share
+///        more than the tracking band at more than half of the heights they share, both ways (a
+///        tree leaning on its post touches it over a part of its height)
 std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& index,
                                            const std::vector<Cluster>& clusters,
                                            const TrunkPath& path, const ModelerConfig& config,
@@ -73,10 +75,12 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
 /// @brief Which points lie on an upright column: within its track's radius plus `band` (m) of
 /// its axis, both read across the axis at the point's height (interpolated between the track's
 /// circles), at heights the track spans. Such points are no branch of the tree: a post's
-/// surface beside a tree came out as branch pieces.
+/// surface beside a tree came out as branch pieces. Points as near the trunk's surface are the
+/// trunk's, where a column touches it.
+/// @param trunk the trunk's track
 /// @return one flag per point of `pts`
 std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
-                                  double band);
+                                  const TrackedTrunk& trunk, double band);
 
 /// @brief Cuts each track that ran onto another column below the circle where it joined it,
 /// and empties one left with fewer than 3 circles. A track joins column b where its centre
