@@ -28,11 +28,10 @@ constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
 // A track whose top third is at least this share of its bottom third's radius does not taper.
-// A group all of whose tracks neither taper nor vary in radius (POLE_RADIUS_SPREAD) is a
-// trellis post or a pole, scored at POLE_WEIGHT (one post beside a tree gathers the tree's
-// branches in its shell and outscored the trunk on two test trees). One track that is no pole
-// is enough: a track that follows a steep scaffold beside the leader grows with it and no
-// longer tapers, where a post's tracks cannot narrow.
+// A group most of whose voting tracks neither taper nor vary in radius (POLE_RADIUS_SPREAD) is
+// a trellis post or a pole, scored at POLE_WEIGHT (one post beside a tree gathers the tree's
+// branches in its shell and outscored the trunk on two test trees). Most, not all: where a
+// leaning tree touches a post, one of the post's tracks takes in the tree's bark and varies.
 constexpr double POLE_TAPER = 0.9;
 constexpr double POLE_WEIGHT = 0.5;
 // A post's circles keep one radius: over a track's lower two thirds (above them a post's track
@@ -40,6 +39,17 @@ constexpr double POLE_WEIGHT = 0.5;
 // at most this share of their median. A trunk's taper and whorls vary it by more; at
 // 12 mm of range noise a thin trunk's taper is lost in the noise, but not its variation.
 constexpr double POLE_RADIUS_SPREAD = 0.025;
+// A post's track ends at the post's top: after its last circle where, over POST_TOP_WINDOW
+// circles around it, the median radius is within POST_TOP_CHANGE of its lower two thirds' or
+// the centres' median offset from the line through their centres is at most POST_TOP_OFF_AXIS
+// of that radius. Where a leaning tree's leader touches the top, the climb goes on onto the
+// leader (narrower, and a post's radius and more off its axis) or around the crown (wider, and
+// off it), and the track would take the tree's crown for the post's. A column of sections (a
+// calibration rig's pipe) narrows on its axis. A window, since at 12 mm of noise a post's
+// circles read 15 % off a few at a time.
+constexpr double POST_TOP_CHANGE = 0.15;
+constexpr std::size_t POST_TOP_WINDOW = 5;
+constexpr double POST_TOP_OFF_AXIS = 0.5;
 constexpr double RETRY_WIDTH = 1.6;     // first circle / start radius above which a low track
                                         // is retried
 constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
@@ -259,6 +269,33 @@ bool keepsOneRadius(const TrackedTrunk& t) {
   return median(std::move(deviation)) <= POLE_RADIUS_SPREAD * middle;
 }
 
+/// A straight line through circle centres, its horizontal position as a function of height.
+struct AxisLine {
+  Eigen::Vector2d at_zero = Eigen::Vector2d::Zero();
+  Eigen::Vector2d per_metre = Eigen::Vector2d::Zero();
+  /// @brief The line's horizontal position at height z (m).
+  Eigen::Vector2d at(double z) const { return at_zero + z * per_metre; }
+};
+
+/// The least-squares line through `centers` (horizontal position against height); a vertical
+/// line through their mean when they span no height.
+AxisLine axisLine(const std::vector<Eigen::Vector3d>& centers) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& c : centers)
+    mean += c;
+  mean /= static_cast<double>(centers.size());
+  double szz = 0.0;
+  Eigen::Vector2d sxz = Eigen::Vector2d::Zero();
+  for (const auto& c : centers) {
+    szz += (c.z() - mean.z()) * (c.z() - mean.z());
+    sxz += (c.z() - mean.z()) * (c - mean).head<2>();
+  }
+  AxisLine line;
+  line.per_metre = szz > 1e-12 ? Eigen::Vector2d(sxz / szz) : Eigen::Vector2d::Zero();
+  line.at_zero = mean.head<2>() - mean.z() * line.per_metre;
+  return line;
+}
+
 /// Whether a track reads as a post or pole: it neither tapers nor varies in radius.
 bool isPole(const TrackedTrunk& t) {
   return !tapers(t) && keepsOneRadius(t);
@@ -377,23 +414,33 @@ int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const
   return chosen;
 }
 
-/// A group's score: the median of its voting tracks' (only those that climb most of the
-/// group's height vote, since a track that stopped at a whorl low on the trunk has a small
-/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when every one reads as
-/// a pole. Negative when it has no voter.
-double groupScore(const std::vector<std::optional<TrackedTrunk>>& tracks,
-                  const std::vector<double>& scores, const std::vector<char>& voters) {
-  std::vector<double> member_scores;
-  bool pole = true;
+/// Whether more than half of a group's voters read as poles (isPole).
+bool readsAsPost(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                 const std::vector<char>& voters) {
+  std::size_t poles = 0, all = 0;
   for (std::size_t k = 0; k < tracks.size(); ++k) {
     if (!voters[k])
       continue;
-    member_scores.push_back(scores[k]);
-    pole = pole && isPole(*tracks[k]);
+    ++all;
+    poles += isPole(*tracks[k]) ? 1 : 0;
+  }
+  return 2 * poles > all;
+}
+
+/// A group's score: the median of its voting tracks' (only those that climb most of the
+/// group's height vote, since a track that stopped at a whorl low on the trunk has a small
+/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when more than half of
+/// them read as poles. Negative when it has no voter.
+double groupScore(const std::vector<std::optional<TrackedTrunk>>& tracks,
+                  const std::vector<double>& scores, const std::vector<char>& voters) {
+  std::vector<double> member_scores;
+  for (std::size_t k = 0; k < tracks.size(); ++k) {
+    if (voters[k])
+      member_scores.push_back(scores[k]);
   }
   if (member_scores.empty())
     return -1.0;
-  return (pole ? POLE_WEIGHT : 1.0) * median(std::move(member_scores));
+  return (readsAsPost(tracks, voters) ? POLE_WEIGHT : 1.0) * median(std::move(member_scores));
 }
 
 /// The best-scoring group's representative (groupScore), or -1.
@@ -589,6 +636,18 @@ void resumeTracks(const Points& pts, const PointIndex& index, double threshold,
   });
 }
 
+/// Every track that keeps one radius cut at its post's top (endAtPostTop); one left with
+/// fewer than MIN_TRACK_CIRCLES circles is no track.
+void endPostsAtTheirTops(std::vector<std::optional<TrackedTrunk>>* tracks) {
+  for (auto& t : *tracks) {
+    if (!t)
+      continue;
+    endAtPostTop(&*t);
+    if (t->centers.size() < MIN_TRACK_CIRCLES)
+      t.reset();
+  }
+}
+
 /// Each track's score (trackScore), -1 where there is no track.
 std::vector<double> scoreTracks(const PointIndex& index, const std::vector<TrunkStart>& starts,
                                 const SearchFrame& frame,
@@ -625,7 +684,14 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
     if (group == g.group[chosen] ||
         std::find(g.group.begin(), g.group.end(), group) == g.group.end())
       continue;
-    const int k = representative(tracks, g, groupVoters(tracks, g, group, frame.zmin));
+    std::vector<char> voters = groupVoters(tracks, g, group, frame.zmin);
+    // A post's column is one of its tracks that read as a post: ended at the post's top, not
+    // run onto a leaning tree's leader above it.
+    if (readsAsPost(tracks, voters)) {
+      for (std::size_t i = 0; i < voters.size(); ++i)
+        voters[i] = voters[i] && isPole(*tracks[i]);
+    }
+    const int k = representative(tracks, g, voters);
     if (k < 0)
       continue;
     if (stands(*tracks[k], starts[k], frame.zmax) &&
@@ -637,6 +703,30 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
 }
 
 }  // namespace
+
+void endAtPostTop(TrackedTrunk* t) {
+  if (!keepsOneRadius(*t))
+    return;
+  const std::size_t n = t->radii.size(), lower = n - n / 3, half = POST_TOP_WINDOW / 2;
+  const double post = median(std::vector<double>(t->radii.begin(), t->radii.begin() + lower));
+  const AxisLine axis =
+      axisLine(std::vector<Eigen::Vector3d>(t->centers.begin(), t->centers.begin() + lower));
+  std::vector<double> off_axis(n);
+  for (std::size_t k = 0; k < n; ++k)
+    off_axis[k] = (t->centers[k].head<2>() - axis.at(t->centers[k].z())).norm();
+  std::size_t top = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t from = k > half ? k - half : 0, to = std::min(n, k + half + 1);
+    const auto window = [&](const std::vector<double>& v) {
+      return median(std::vector<double>(v.begin() + from, v.begin() + to));
+    };
+    if (std::abs(window(t->radii) - post) <= POST_TOP_CHANGE * post ||
+        window(off_axis) <= POST_TOP_OFF_AXIS * post)
+      top = k;
+  }
+  t->centers.resize(top + 1);
+  t->radii.resize(top + 1);
+}
 
 void cutWhereJoined(std::vector<std::optional<TrackedTrunk>>* tracks) {
   const std::size_t m = tracks->size();
@@ -694,6 +784,7 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
     trackStarts(pts, index, starts, from, threshold, frame, config, &tracks);
   }
   resumeTracks(pts, index, threshold, config, &tracks);
+  endPostsAtTheirTops(&tracks);
   cutWhereJoined(&tracks);
   const std::vector<double> scores = scoreTracks(index, starts, frame, tracks);
   const TrackGroups groups = groupTracks(tracks);

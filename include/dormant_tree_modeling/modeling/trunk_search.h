@@ -92,11 +92,22 @@ std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTr
 ///        against the others as they were given
 void cutWhereJoined(std::vector<std::optional<TrackedTrunk>>* tracks);
 
+/// @brief Ends a post's track at the post's top. A track whose circles keep one radius over
+/// its lower two thirds (median absolute deviation at most 2.5 % of their median, as a post's
+/// do and a trunk's do not) is cut after its last circle where, over the 5 circles around it,
+/// the median radius is within 15 % of that median or the centres' median offset from the line
+/// through the lower two thirds' centres is at most half of it: a column of sections (a
+/// calibration rig's pipe) narrows on its axis, a post's top does not. Where a leaning tree's
+/// leader touches a post's top, the climb goes on onto the leader or around the crown, and the
+/// track would take the tree's crown for the post's. Any other track is left as it is.
+/// @param track cut in place
+void endAtPostTop(TrackedTrunk* track);
+
 /// @brief The trunk among tracked candidates. Tracks whose lowest BASE_HEIGHT stand on one base
 /// are one trunk (a group); a group scores the median of its voters, the tracks that climb
-/// most of its height (a track that stopped at a whorl has a small shell), halved when none of
-/// them narrows upwards (a post's tracks cannot; a track that follows a steep scaffold beside
-/// the leader need not), and is represented
+/// most of its height (a track that stopped at a whorl has a small shell), halved when most of
+/// them read as posts (neither narrowing upwards nor varying in radius: a post's tracks do
+/// neither; one whose lower part a leaning tree touches may vary), and is represented
 /// by the highest voter among those that stray alike from the others: a track that follows a
 /// scaffold strays from the leader's, and one that stopped low is no judge of either.
 /// @param tracks one per start, empty where the start gave no track
