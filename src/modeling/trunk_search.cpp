@@ -269,33 +269,6 @@ bool keepsOneRadius(const TrackedTrunk& t) {
   return median(std::move(deviation)) <= POLE_RADIUS_SPREAD * middle;
 }
 
-/// A straight line through circle centres, its horizontal position as a function of height.
-struct AxisLine {
-  Eigen::Vector2d at_zero = Eigen::Vector2d::Zero();
-  Eigen::Vector2d per_metre = Eigen::Vector2d::Zero();
-  /// @brief The line's horizontal position at height z (m).
-  Eigen::Vector2d at(double z) const { return at_zero + z * per_metre; }
-};
-
-/// The least-squares line through `centers` (horizontal position against height); a vertical
-/// line through their mean when they span no height.
-AxisLine axisLine(const std::vector<Eigen::Vector3d>& centers) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& c : centers)
-    mean += c;
-  mean /= static_cast<double>(centers.size());
-  double szz = 0.0;
-  Eigen::Vector2d sxz = Eigen::Vector2d::Zero();
-  for (const auto& c : centers) {
-    szz += (c.z() - mean.z()) * (c.z() - mean.z());
-    sxz += (c.z() - mean.z()) * (c - mean).head<2>();
-  }
-  AxisLine line;
-  line.per_metre = szz > 1e-12 ? Eigen::Vector2d(sxz / szz) : Eigen::Vector2d::Zero();
-  line.at_zero = mean.head<2>() - mean.z() * line.per_metre;
-  return line;
-}
-
 /// Whether a track reads as a post or pole: it neither tapers nor varies in radius.
 bool isPole(const TrackedTrunk& t) {
   return !tapers(t) && keepsOneRadius(t);
@@ -709,11 +682,11 @@ void endAtPostTop(TrackedTrunk* t) {
     return;
   const std::size_t n = t->radii.size(), lower = n - n / 3, half = POST_TOP_WINDOW / 2;
   const double post = median(std::vector<double>(t->radii.begin(), t->radii.begin() + lower));
-  const AxisLine axis =
-      axisLine(std::vector<Eigen::Vector3d>(t->centers.begin(), t->centers.begin() + lower));
+  Cylinder axis;
+  axis.axis = principalAxis(Points(t->centers.begin(), t->centers.begin() + lower), &axis.center);
   std::vector<double> off_axis(n);
   for (std::size_t k = 0; k < n; ++k)
-    off_axis[k] = (t->centers[k].head<2>() - axis.at(t->centers[k].z())).norm();
+    off_axis[k] = axisDistance(axis, t->centers[k]);
   std::size_t top = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t from = k > half ? k - half : 0, to = std::min(n, k + half + 1);
@@ -809,16 +782,12 @@ std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTr
   if (columns.empty())
     return on;
   parallelFor(static_cast<int>(pts.size()), [&](int i) {
-    const auto on_trunk = surfaceGapAt(trunk, pts[i]);
-    if (on_trunk && *on_trunk <= band)
-      return;
-    for (const auto& column : columns) {
-      const auto gap = surfaceGapAt(column, pts[i]);
-      if (gap && *gap <= band) {
-        on[i] = 1;
-        return;
-      }
-    }
+    const auto near = [&](const TrackedTrunk& track) {
+      const auto gap = surfaceGapAt(track, pts[i]);
+      return gap && *gap <= band;
+    };
+    // The trunk's gap only for points on a column: most points are near none.
+    on[i] = std::any_of(columns.begin(), columns.end(), near) && !near(trunk);
   });
   return on;
 }

@@ -21,8 +21,8 @@ struct TrunkCandidate {
   double bottom = 0.0, top = 0.0;  ///< z range of the track (m)
   double median_radius = 0.0;      ///< of the track's circles (m)
   double score = -1.0;             ///< branch points around it, weighted
-  /// its radius neither narrows upwards nor varies: a group all of whose voters read so is
-  /// scored as a post
+  /// its radius neither narrows upwards nor varies: a group more than half of whose voters
+  /// read so is scored as a post
   bool pole = false;
   int group = -1;       ///< candidates whose tracks follow one trunk share a group
   bool chosen = false;  ///< the track that became the trunk's axis
