@@ -357,6 +357,15 @@ PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
   return pb;
 }
 
+/// Removes from `region` the points flagged in `on`; how many it removed.
+int dropPointsOn(const std::vector<char>& on, std::vector<int>* region) {
+  const auto end =
+      std::remove_if(region->begin(), region->end(), [&](int i) { return on[i] != 0; });
+  const auto dropped = static_cast<int>(region->end() - end);
+  region->erase(end, region->end());
+  return dropped;
+}
+
 }  // namespace
 
 ModelerConfig stageConfig(const ModelerConfig& config) {
@@ -427,11 +436,8 @@ ModelResult TreeModeler::model(const Points& input) const {
     }
   }
   watch.lap("track");
-  const TrunkModel trunk =
+  TrunkModel trunk =
       modelTrunk(pts, region.points, region.axis, region.radius, config_, region.radii);
-  result.noise_sigma = trunk.noise_sigma;
-  result.table_noise_sigma = trunk.table_sigma;
-  watch.lap("trunk");
   requireScannedSurface(trunk.search_sigma);
   // Another column's surface is taken as wide as the trunk's cylinders take theirs: the band
   // that picks a surface out of clutter.
@@ -439,6 +445,14 @@ ModelResult TreeModeler::model(const Points& input) const {
       std::max(config_.fit.cylinder_threshold_m, noiseBand(trunk.search_sigma));
   const std::vector<char> on_columns =
       pointsOnColumns(pts, columns, TrackedTrunk{region.axis, region.radii}, column_band);
+  // A post within the trunk's reach is no part of the trunk: its near side widened the slices
+  // of a leader leaning to within centimetres of it. Modelled again without it.
+  result.trunk_column_points = dropPointsOn(on_columns, &region.points);
+  if (result.trunk_column_points > 0)
+    trunk = modelTrunk(pts, region.points, region.axis, region.radius, config_, region.radii);
+  result.noise_sigma = trunk.noise_sigma;
+  result.table_noise_sigma = trunk.table_sigma;
+  watch.lap("trunk");
   result.column_points = static_cast<int>(std::count(on_columns.begin(), on_columns.end(), 1));
   const auto branches =
       modelBranches(pts, index, trunk, region.points, config_, &result.rejected_branches,

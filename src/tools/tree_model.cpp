@@ -125,7 +125,9 @@ int main(int argc, char** argv) {
                   << "\n";
       }
       std::cerr << "  " << result.column_points
-                << " points on other upright columns left out of the branch search\n";
+                << " points on other upright columns left out of the branch search, "
+                << result.trunk_column_points << " of them within the trunk's reach left out of "
+                << "its cylinders too\n";
     }
     std::cout << "tree_model: " << result.model.trunk.size() << " trunk cylinders, "
               << result.model.primary_branches.size() << " primary branches in "

@@ -42,6 +42,8 @@ struct ModelResult {
   /// points on other upright columns (TrunkCandidate::other_column), left out of the branch
   /// search
   int column_points = 0;
+  /// of those, the ones within the trunk's reach: left out of its cylinders too
+  int trunk_column_points = 0;
 };
 
 /// @brief The configuration as the stages run it: validated, and with noise.correct_bias
