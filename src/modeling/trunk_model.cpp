@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <optional>
 
@@ -65,12 +66,43 @@ constexpr int RESUME_LINE_SLICES = 6;
 constexpr int MAX_RESUMES = 3;
 // A track that took a branch at a fork (a steep scaffold nearly as thick as the leader and
 // scanned more densely) turns off the leader's line and ends where the branch thins out, up to
-// FORK_MAX_BACKOFF_M above the fork. It is resumed from each circle that far below its end, a
+// FORK_MAX_BACKOFF_M above the fork: 50 cm for a 20 mm scaffold leaving at 24 degrees, 80 cm
+// for a 27 mm one leaving at 18. It is resumed from each circle that far below its end, a
 // climb along the line beneath starting FORK_SKIP_M above that circle: there a branch leaving
 // at 20 degrees or more stands 3.6 cm or more off the leader's axis, clear of a young leader
 // (their radii sum to 2-3 cm), and no longer draws the climb's first circle.
-constexpr double FORK_MAX_BACKOFF_M = 0.6;
+constexpr double FORK_MAX_BACKOFF_M = 1.0;
 constexpr double FORK_SKIP_M = 0.1;
+// The trunk's axis at each height is a polynomial in the height through the circle centres
+// (the track's, then the slices') within a window around it. How local is chosen by the
+// centres themselves: each smoothing predicts every centre from the others (leave one out),
+// and a more local one replaces a stiffer one only when its median miss is at most
+// AXIS_LOCAL_GAIN of the stiffer one's. A crooked leader sways with a wavelength of a metre or
+// more, and only a window of a few decimetres follows it (seed 140's crooked tree at 6 mm:
+// one cubic over the trunk missed its centres by 48 mm, quadratics over 50 cm by 5); where the
+// centres scatter without a trend (the real adtree_tree1 trunk among its crown's forks: 12-20
+// mm whatever the window), the stiff cubic stays.
+struct AxisSmoothing {
+  double half_window_m;  ///< centres within this height of the point; infinite: all of them
+  int degree;
+};
+constexpr AxisSmoothing AXIS_SMOOTHINGS[] = {  // stiffest first
+    {std::numeric_limits<double>::infinity(), 3},
+    {1.0, 2},
+    {0.5, 2},
+    {0.25, 2}};
+constexpr double AXIS_LOCAL_GAIN = 0.5;
+// Misses under this are within any circle centre's scatter: no smoothing is more local for them.
+constexpr double AXIS_MIN_MISS_M = 0.002;
+// A centre off a fit by more than AXIS_OUTLIER_MEDIANS median distances (at least
+// AXIS_OUTLIER_FLOOR_M) is pulled aside by a branch: it is dropped and the fit done again, in
+// AXIS_FIT_ROUNDS rounds, unless fewer than AXIS_MIN_KEPT would stay.
+constexpr int AXIS_FIT_ROUNDS = 3;
+constexpr double AXIS_OUTLIER_MEDIANS = 2.5;
+constexpr double AXIS_OUTLIER_FLOOR_M = 0.01;
+constexpr std::size_t AXIS_MIN_KEPT = 3;
+// Heights are scaled by at most this (m) in the fits' polynomials, for their conditioning.
+constexpr double AXIS_MAX_SCALE_M = 1.0;
 
 /// Radius range a slice circle may take and how far from the centreline its points may lie.
 struct SliceBounds {
@@ -305,63 +337,103 @@ std::vector<Slice> computeSlices(const Points& pts, const std::vector<int>& regi
   return slices;
 }
 
-/// A smooth trunk axis through noisy centres: x(z) and y(z) as cubic polynomials, fitted with
-/// two rounds of outlier rejection (a centre pulled aside by a branch), sampled every `step`.
+/// The point at height z of x and y fitted as polynomials of `degree` in the height to the
+/// centres, in AXIS_FIT_ROUNDS rounds that drop centres pulled aside (AXIS_OUTLIER_MEDIANS);
+/// fewer centres than terms take a lower degree. Nothing without centres.
+std::optional<Eigen::Vector3d> axisPointFit(std::vector<Eigen::Vector3d> centres, double z,
+                                            int degree, double scale) {
+  if (centres.empty())
+    return std::nullopt;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  for (int round = 0; round < AXIS_FIT_ROUNDS; ++round) {
+    const int terms = std::clamp(static_cast<int>(centres.size()) - 1, 1, degree + 1);
+    Eigen::MatrixXd A(centres.size(), terms);
+    Eigen::MatrixXd xy(centres.size(), 2);
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      const double t = (centres[i].z() - z) / scale;
+      for (int k = 0; k < terms; ++k)
+        A(i, k) = std::pow(t, k);
+      xy.row(i) = centres[i].head<2>().transpose();
+    }
+    const Eigen::MatrixXd coefficients = A.colPivHouseholderQr().solve(xy);
+    at = coefficients.row(0).transpose();
+    if (round + 1 == AXIS_FIT_ROUNDS)
+      break;
+    std::vector<double> off(centres.size());
+    for (std::size_t i = 0; i < centres.size(); ++i)
+      off[i] = (A.row(i) * coefficients - xy.row(i)).norm();
+    const double limit = std::max(AXIS_OUTLIER_FLOOR_M, AXIS_OUTLIER_MEDIANS * median(off));
+    std::vector<Eigen::Vector3d> kept;
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      if (off[i] <= limit)
+        kept.push_back(centres[i]);
+    }
+    if (kept.size() < AXIS_MIN_KEPT || kept.size() == centres.size())
+      break;
+    centres.swap(kept);
+  }
+  if (!at.allFinite())
+    return std::nullopt;
+  return Eigen::Vector3d(at.x(), at.y(), z);
+}
+
+/// The axis point at height z under `smoothing`, from the centres in its window but the one at
+/// index `left_out` (none: -1).
+std::optional<Eigen::Vector3d> axisPointAt(const std::vector<Eigen::Vector3d>& centres, double z,
+                                           const AxisSmoothing& smoothing, int left_out = -1) {
+  std::vector<Eigen::Vector3d> window;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    if (static_cast<int>(i) != left_out && std::abs(centres[i].z() - z) <= smoothing.half_window_m)
+      window.push_back(centres[i]);
+  }
+  return axisPointFit(std::move(window), z, smoothing.degree,
+                      std::min(smoothing.half_window_m, AXIS_MAX_SCALE_M));
+}
+
+/// The median distance (m) between each centre and the axis point `smoothing` predicts at its
+/// height from the others; infinite when it predicts none.
+double leaveOneOutMiss(const std::vector<Eigen::Vector3d>& centres,
+                       const AxisSmoothing& smoothing) {
+  std::vector<double> miss;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    if (const auto p = axisPointAt(centres, centres[i].z(), smoothing, static_cast<int>(i)))
+      miss.push_back((p->head<2>() - centres[i].head<2>()).norm());
+  }
+  return miss.empty() ? std::numeric_limits<double>::infinity() : median(miss);
+}
+
+/// The smoothing of AXIS_SMOOTHINGS the centres call for (AXIS_LOCAL_GAIN).
+const AxisSmoothing& chooseSmoothing(const std::vector<Eigen::Vector3d>& centres) {
+  const AxisSmoothing* chosen = std::begin(AXIS_SMOOTHINGS);
+  double chosen_miss = leaveOneOutMiss(centres, *chosen);
+  for (const AxisSmoothing* local = chosen + 1; local != std::end(AXIS_SMOOTHINGS); ++local) {
+    const double miss = leaveOneOutMiss(centres, *local);
+    if (chosen_miss > AXIS_MIN_MISS_M && miss < AXIS_LOCAL_GAIN * chosen_miss) {
+      chosen = local;
+      chosen_miss = miss;
+    }
+  }
+  return *chosen;
+}
+
+/// A smooth trunk axis through noisy centres, sampled every `step` over their heights, with
+/// the smoothing they call for (chooseSmoothing).
 std::vector<Eigen::Vector3d> smoothAxis(const std::vector<Eigen::Vector3d>& centres, double step) {
-  std::vector<Eigen::Vector3d> pts = centres;
-  double z0 = 1e300, z1 = -1e300;
-  for (const auto& c : pts) {
+  double z0 = std::numeric_limits<double>::infinity(), z1 = -z0;
+  for (const auto& c : centres) {
     z0 = std::min(z0, c.z());
     z1 = std::max(z1, c.z());
   }
-  if (pts.size() < 2 || z1 - z0 < 1e-6)
+  if (centres.size() < 2 || z1 - z0 < 1e-6)
     return centres;
-  const double span = z1 - z0;
-  Eigen::Vector4d cx = Eigen::Vector4d::Zero(), cy = Eigen::Vector4d::Zero();
-  for (int round = 0; round < 3; ++round) {
-    const int degree = std::min<int>(3, static_cast<int>(pts.size()) - 1);
-    Eigen::MatrixXd A(pts.size(), degree + 1);
-    Eigen::VectorXd bx(pts.size()), by(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const double t = (pts[i].z() - z0) / span;
-      for (int k = 0; k <= degree; ++k)
-        A(i, k) = std::pow(t, k);
-      bx(i) = pts[i].x();
-      by(i) = pts[i].y();
-    }
-    const auto qr = A.colPivHouseholderQr();
-    cx.setZero();
-    cy.setZero();
-    cx.head(degree + 1) = qr.solve(bx);
-    cy.head(degree + 1) = qr.solve(by);
-    if (round == 2)
-      break;
-    std::vector<double> res;
-    auto residual = [&](const Eigen::Vector3d& p) {
-      const double t = (p.z() - z0) / span;
-      const Eigen::Vector4d T(1, t, t * t, t * t * t);
-      return std::hypot(p.x() - cx.dot(T), p.y() - cy.dot(T));
-    };
-    for (const auto& p : pts)
-      res.push_back(residual(p));
-    const double limit = std::max(0.01, 2.5 * median(res));
-    std::vector<Eigen::Vector3d> kept;
-    for (const auto& p : pts) {
-      if (residual(p) <= limit)
-        kept.push_back(p);
-    }
-    if (kept.size() < 4)
-      break;
-    pts.swap(kept);
-  }
+  const AxisSmoothing& smoothing = chooseSmoothing(centres);
   std::vector<Eigen::Vector3d> out;
-  const int n = std::max(1, static_cast<int>(std::ceil(span / step)));
+  const int n = std::max(1, static_cast<int>(std::ceil((z1 - z0) / step)));
   for (int i = 0; i <= n; ++i) {
-    const double t = static_cast<double>(i) / n;
-    const Eigen::Vector4d T(1, t, t * t, t * t * t);
-    out.emplace_back(cx.dot(T), cy.dot(T), z0 + t * span);
+    if (const auto p = axisPointAt(centres, z0 + (z1 - z0) * i / n, smoothing))
+      out.push_back(*p);
   }
-  return out;
+  return out.size() >= 2 ? out : centres;
 }
 
 /// Running median of the slice radii over +/- 3 slices: the radius a slice should continue.

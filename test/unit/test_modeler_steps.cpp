@@ -427,6 +427,41 @@ TEST(TrunkTracking, ATrackThatTookASteepScaffoldAtAForkIsResumedOnTheLeader) {
   EXPECT_LT(worst_above, 0.01);
 }
 
+TEST(TrunkTracking, AScaffoldTheTrackFollowsFarAboveTheForkDoesNotHideTheLeader) {
+  // Seed 259's steep-scaffold tree at 3 mm, reduced: a leader (r 18 mm, up to 3.5 m) and a
+  // scaffold nearly as thick (r 13 mm, twice as densely scanned) leaving it at 1.75 m at 18
+  // degrees from the vertical, 0.9 m long. At so narrow an angle the track follows the
+  // scaffold to its end, about 80 cm above the fork; resumed from circles that far below its
+  // end, it must climb the leader.
+  Points pts;
+  Rng rng(31);
+  const double sigma = 0.003, fork_z = 1.75;
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.018, 3.5, 40000, sigma);
+  const double lean = 18.0 * M_PI / 180.0;
+  addNoisyTube(pts, rng, {0, 0, fork_z}, {std::sin(lean), 0, std::cos(lean)}, 0.013, 0.9, 15000,
+               sigma);
+  const PointIndex index(pts);
+  ModelerConfig config;
+  const TrackedTrunk track =
+      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, 0.018, 2.5 * sigma, config);
+  ASSERT_FALSE(track.centers.empty());
+  const TrackedTrunk resumed = resumePastWhorlsAndForks(pts, index, track, 2.5 * sigma, config);
+  double worst_above = 0.0;
+  for (const auto& c : resumed.centers) {
+    if (c.z() > fork_z + 0.1)
+      worst_above = std::max(worst_above, c.head<2>().norm());
+  }
+  std::printf(
+      "[ INFO ] track top %.2f m, %.0f mm off the leader; resumed top %.2f m, at most "
+      "%.1f mm off above the fork\n",
+      track.centers.back().z(), 1000 * track.centers.back().head<2>().norm(),
+      resumed.centers.back().z(), 1000 * worst_above);
+  ASSERT_GT(track.centers.back().head<2>().norm(), 0.2) << "the fixture no longer misleads";
+  ASSERT_GT(track.centers.back().z() - fork_z, 0.65) << "the fixture's scaffold is too short";
+  EXPECT_GT(resumed.centers.back().z(), 3.3);
+  EXPECT_LT(worst_above, 0.01);
+}
+
 TEST(TrunkTracking, ATrackThatEndsAtTheTrunksTopIsNotResumed) {
   Points pts;
   Rng rng(12);

@@ -176,6 +176,59 @@ TEST(TrunkSegments, SlicesFollowTheTrackedRadiusPastScaffoldsAroundTheTop) {
   EXPECT_GT(worstAboveTheRods(one), 0.01);
 }
 
+/// A crooked leader: it sways along x with a 2 m wavelength, from nothing at the ground to
+/// 8 cm at its 3.6 m top, as the simulator's crooked-leader trees do.
+constexpr double CROOKED_HEIGHT = 3.6;
+Eigen::Vector3d crookedAxisAt(double z) {
+  const double sway = 0.08 * z / CROOKED_HEIGHT * std::sin(2.0 * M_PI * z / 2.0);
+  return {sway, 0.0, z};
+}
+
+/// Rings around the crooked axis, square to it, every 5 mm, tapering from 4 cm to 1.5 cm.
+Points crookedTrunk() {
+  Points pts;
+  const double step = 0.005;
+  for (double z = 0.0; z <= CROOKED_HEIGHT; z += step) {
+    const Eigen::Vector3d c = crookedAxisAt(z);
+    const Eigen::Vector3d t = (crookedAxisAt(z + step) - c).normalized();
+    const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
+    const double r = 0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT;
+    for (int k = 0; k < 48; ++k) {
+      const double phi = 2.0 * M_PI * k / 48;
+      pts.push_back(c + r * (std::cos(phi) * u + std::sin(phi) * v));
+    }
+  }
+  return pts;
+}
+
+TEST(TrunkSegments, TheCylindersFollowACrookedLeader) {
+  // The track's circles lie on the axis, 5 cm apart. The centreline through them is local:
+  // no one curve over the whole trunk, which cuts a sway's bends.
+  const Points pts = crookedTrunk();
+  std::vector<Eigen::Vector3d> axis;
+  std::vector<double> radii;
+  for (double z = 0.0; z <= CROOKED_HEIGHT + 1e-9; z += 0.05) {
+    axis.push_back(crookedAxisAt(z));
+    radii.push_back(0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT);
+  }
+  const TrunkModel trunk = modelTrunk(pts, allOf(pts), axis, 0.03, idealScanner(), radii);
+  ASSERT_GE(trunk.cylinders.size(), 4u);
+  double line_worst = 0.0, worst = 0.0;
+  const Centerline& line = trunk.centerline;
+  for (double s = 0.0; s <= line.length(); s += 0.01) {
+    const Eigen::Vector3d p = line.pointAt(s);
+    line_worst = std::max(line_worst, (p - crookedAxisAt(p.z())).head<2>().norm());
+  }
+  for (const auto& c : trunk.cylinders)
+    worst = std::max(worst, (c.center - crookedAxisAt(c.center.z())).head<2>().norm());
+  std::printf(
+      "[ INFO ] centreline at most %.1f mm off the axis; %zu cylinders, their centres at most "
+      "%.1f mm off\n",
+      1000 * line_worst, trunk.cylinders.size(), 1000 * worst);
+  EXPECT_LT(line_worst, 0.005);
+  EXPECT_LT(worst, 0.01);
+}
+
 /// `pts` with every point moved off the trunk's axis by Gaussian noise of sigma (m).
 Points radialNoise(Points pts, double sigma, std::uint64_t seed) {
   Rng rng(seed);
