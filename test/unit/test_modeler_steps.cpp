@@ -394,37 +394,61 @@ TEST(TrunkTracking, AfterAWhorlPullsTheTrackAsideItIsResumedOnTheTrunkAbove) {
   }
 }
 
+/// A vertical leader from the ground and a straight scaffold leaving it at FORK_Z to +x, both
+/// seen all around with radial noise.
+constexpr double FORK_Z = 1.75;
+struct Fork {
+  std::uint64_t seed;
+  double sigma;  ///< m of radial noise
+  double leader_radius, leader_height;
+  double scaffold_radius, scaffold_lean_deg, scaffold_length;
+  int scaffold_points;  ///< the leader has 40000
+};
+
+/// The fork's track from 0.1 m up, and that track resumed past whorls and forks.
+struct ForkTracks {
+  TrackedTrunk track, resumed;
+  double worst_above = 0.0;  ///< m: the resumed track's farthest circle from the leader's
+                             ///< axis more than 10 cm above the fork
+};
+
+ForkTracks trackAtFork(const Fork& f) {
+  Points pts;
+  Rng rng(f.seed);
+  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, f.leader_radius, f.leader_height, 40000, f.sigma);
+  const double lean = f.scaffold_lean_deg * M_PI / 180.0;
+  addNoisyTube(pts, rng, {0, 0, FORK_Z}, {std::sin(lean), 0, std::cos(lean)}, f.scaffold_radius,
+               f.scaffold_length, f.scaffold_points, f.sigma);
+  const PointIndex index(pts);
+  ModelerConfig config;
+  ForkTracks out;
+  out.track =
+      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, f.leader_radius, 2.5 * f.sigma, config);
+  if (out.track.centers.empty())
+    return out;
+  out.resumed = resumePastWhorlsAndForks(pts, index, out.track, 2.5 * f.sigma, config);
+  for (const auto& c : out.resumed.centers) {
+    if (c.z() > FORK_Z + 0.1)
+      out.worst_above = std::max(out.worst_above, c.head<2>().norm());
+  }
+  std::printf(
+      "[ INFO ] track top %.2f m, %.0f mm off the leader; resumed top %.2f m, at most "
+      "%.1f mm off above the fork\n",
+      out.track.centers.back().z(), 1000 * out.track.centers.back().head<2>().norm(),
+      out.resumed.centers.back().z(), 1000 * out.worst_above);
+  return out;
+}
+
 TEST(TrunkTracking, ATrackThatTookASteepScaffoldAtAForkIsResumedOnTheLeader) {
   // A young leader (r 14 mm, up to 3 m) and a steep scaffold nearly as thick (r 10 mm, twice
   // as densely scanned) that leaves it at 1.75 m at 24 degrees from the vertical, with 7 mm
   // radial noise: at the fork the slices' centres follow the scaffold, and the track ends where
   // it does. Resumed past the fork along the leader's line beneath, it must climb the leader.
-  Points pts;
-  Rng rng(23);
-  const double sigma = 0.007, fork_z = 1.75;
-  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.014, 3.0, 40000, sigma);
-  const double lean = 24.0 * M_PI / 180.0;
-  addNoisyTube(pts, rng, {0, 0, fork_z}, {std::sin(lean), 0, std::cos(lean)}, 0.010, 0.6, 16000,
-               sigma);
-  const PointIndex index(pts);
-  ModelerConfig config;
-  const TrackedTrunk track =
-      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, 0.014, 2.5 * sigma, config);
-  ASSERT_FALSE(track.centers.empty());
-  const TrackedTrunk resumed = resumePastWhorlsAndForks(pts, index, track, 2.5 * sigma, config);
-  double worst_above = 0.0;
-  for (const auto& c : resumed.centers) {
-    if (c.z() > fork_z + 0.1)
-      worst_above = std::max(worst_above, c.head<2>().norm());
-  }
-  std::printf(
-      "[ INFO ] track top %.2f m, %.0f mm off the leader; resumed top %.2f m, at most "
-      "%.1f mm off above the fork\n",
-      track.centers.back().z(), 1000 * track.centers.back().head<2>().norm(),
-      resumed.centers.back().z(), 1000 * worst_above);
-  EXPECT_GT(track.centers.back().head<2>().norm(), 0.1) << "the fixture no longer misleads";
-  EXPECT_GT(resumed.centers.back().z(), 2.8);
-  EXPECT_LT(worst_above, 0.01);
+  const ForkTracks t = trackAtFork({23, 0.007, 0.014, 3.0, 0.010, 24.0, 0.6, 16000});
+  ASSERT_FALSE(t.track.centers.empty());
+  EXPECT_GT(t.track.centers.back().head<2>().norm(), 0.1) << "the fixture no longer misleads";
+  EXPECT_GT(t.resumed.centers.back().z(), 2.8);
+  EXPECT_LT(t.worst_above, 0.01);
 }
 
 TEST(TrunkTracking, AScaffoldTheTrackFollowsFarAboveTheForkDoesNotHideTheLeader) {
@@ -433,33 +457,12 @@ TEST(TrunkTracking, AScaffoldTheTrackFollowsFarAboveTheForkDoesNotHideTheLeader)
   // degrees from the vertical, 0.9 m long. At so narrow an angle the track follows the
   // scaffold to its end, about 80 cm above the fork; resumed from circles that far below its
   // end, it must climb the leader.
-  Points pts;
-  Rng rng(31);
-  const double sigma = 0.003, fork_z = 1.75;
-  addNoisyTube(pts, rng, {0, 0, 0}, {0, 0, 1}, 0.018, 3.5, 40000, sigma);
-  const double lean = 18.0 * M_PI / 180.0;
-  addNoisyTube(pts, rng, {0, 0, fork_z}, {std::sin(lean), 0, std::cos(lean)}, 0.013, 0.9, 15000,
-               sigma);
-  const PointIndex index(pts);
-  ModelerConfig config;
-  const TrackedTrunk track =
-      trackTrunk(pts, index, {0, 0, 0.1}, {0, 0, 1}, 0.018, 2.5 * sigma, config);
-  ASSERT_FALSE(track.centers.empty());
-  const TrackedTrunk resumed = resumePastWhorlsAndForks(pts, index, track, 2.5 * sigma, config);
-  double worst_above = 0.0;
-  for (const auto& c : resumed.centers) {
-    if (c.z() > fork_z + 0.1)
-      worst_above = std::max(worst_above, c.head<2>().norm());
-  }
-  std::printf(
-      "[ INFO ] track top %.2f m, %.0f mm off the leader; resumed top %.2f m, at most "
-      "%.1f mm off above the fork\n",
-      track.centers.back().z(), 1000 * track.centers.back().head<2>().norm(),
-      resumed.centers.back().z(), 1000 * worst_above);
-  ASSERT_GT(track.centers.back().head<2>().norm(), 0.2) << "the fixture no longer misleads";
-  ASSERT_GT(track.centers.back().z() - fork_z, 0.65) << "the fixture's scaffold is too short";
-  EXPECT_GT(resumed.centers.back().z(), 3.3);
-  EXPECT_LT(worst_above, 0.01);
+  const ForkTracks t = trackAtFork({31, 0.003, 0.018, 3.5, 0.013, 18.0, 0.9, 15000});
+  ASSERT_FALSE(t.track.centers.empty());
+  ASSERT_GT(t.track.centers.back().head<2>().norm(), 0.2) << "the fixture no longer misleads";
+  ASSERT_GT(t.track.centers.back().z() - FORK_Z, 0.65) << "the fixture's scaffold is too short";
+  EXPECT_GT(t.resumed.centers.back().z(), 3.3);
+  EXPECT_LT(t.worst_above, 0.01);
 }
 
 TEST(TrunkTracking, ATrackThatEndsAtTheTrunksTopIsNotResumed) {
