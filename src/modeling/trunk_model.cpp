@@ -741,6 +741,16 @@ LineBeneath lineBeneath(const TrackedTrunk& track, std::size_t kept) {
   return line;
 }
 
+/// The track's first `kept` circles followed by `more`'s.
+TrackedTrunk joinedAt(const TrackedTrunk& track, std::size_t kept, const TrackedTrunk& more) {
+  TrackedTrunk joined;
+  joined.centers.assign(track.centers.begin(), track.centers.begin() + kept);
+  joined.radii.assign(track.radii.begin(), track.radii.begin() + kept);
+  joined.centers.insert(joined.centers.end(), more.centers.begin(), more.centers.end());
+  joined.radii.insert(joined.radii.end(), more.radii.begin(), more.radii.end());
+  return joined;
+}
+
 /// The track's first `kept` circles joined with a climb from `from` along the line beneath
 /// them; nothing when that climb ends within a slice of the track's end.
 std::optional<TrackedTrunk> climbOnFrom(const Points& pts, const PointIndex& index,
@@ -752,12 +762,7 @@ std::optional<TrackedTrunk> climbOnFrom(const Points& pts, const PointIndex& ind
   if (more.centers.empty() ||
       (more.centers.back() - track.centers.back()).dot(line.axis) <= config.trunk.slice_height_m)
     return std::nullopt;
-  TrackedTrunk joined;
-  joined.centers.assign(track.centers.begin(), track.centers.begin() + kept);
-  joined.radii.assign(track.radii.begin(), track.radii.begin() + kept);
-  joined.centers.insert(joined.centers.end(), more.centers.begin(), more.centers.end());
-  joined.radii.insert(joined.radii.end(), more.radii.begin(), more.radii.end());
-  return joined;
+  return joinedAt(track, kept, more);
 }
 
 /// Whether the track's end lies off the line beneath its first `kept` circles: it was pulled
@@ -849,6 +854,20 @@ TrackedTrunk resumePastWhorlsAndForks(const Points& pts, const PointIndex& index
                                       TrackedTrunk track, double threshold,
                                       const ModelerConfig& config) {
   return resumeRepeatedly(pts, index, std::move(track), threshold, config, true);
+}
+
+std::optional<TrackedTrunk> climbAgainFrom(const Points& pts, const PointIndex& index,
+                                           const TrackedTrunk& track, std::size_t kept,
+                                           double threshold, const ModelerConfig& config) {
+  if (kept < static_cast<std::size_t>(RESUME_LINE_SLICES) || kept > track.centers.size())
+    return std::nullopt;
+  const LineBeneath line = lineBeneath(track, kept);
+  const TrackedTrunk more =
+      trackTrunk(pts, index, line.levelWith(track.centers[kept - 1]), line.axis, line.radius,
+                 threshold, config, TRACK_MAX_MISSES, true);
+  if (more.centers.empty())
+    return std::nullopt;
+  return resumePastWhorlsAndForks(pts, index, joinedAt(track, kept, more), threshold, config);
 }
 
 double estimateNoiseSigma(const Points& pts, const Centerline& line,

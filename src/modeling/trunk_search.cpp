@@ -28,10 +28,11 @@ constexpr double SAME_TRUNK_MIN = 0.03;     // m: tracks closer than this follow
 constexpr double STRAY_TIE = 0.005;         // m of mean offset per other track: strays alike
 constexpr double BASE_HEIGHT = 0.6;         // m of a track's bottom that says which trunk it is
 // A track whose top third is at least this share of its bottom third's radius does not taper.
-// A group most of whose voting tracks neither taper nor vary in radius (POLE_RADIUS_SPREAD) is
-// a trellis post or a pole, scored at POLE_WEIGHT (one post beside a tree gathers the tree's
-// branches in its shell and outscored the trunk on two test trees). Most, not all: where a
-// leaning tree touches a post, one of the post's tracks takes in the tree's bark and varies.
+// A group one of whose voting tracks neither tapers nor varies in radius (POLE_RADIUS_SPREAD)
+// is a trellis post or a pole, scored at POLE_WEIGHT (one post beside a tree gathers the
+// tree's branches in its shell and outscored the trunk on two test trees). One, not most:
+// where a leaning tree touches a post, the post's other tracks take in the tree's bark or
+// settle off its axis for a stretch and vary; no trunk track reads as a pole.
 constexpr double POLE_TAPER = 0.9;
 constexpr double POLE_WEIGHT = 0.5;
 // A post's circles keep one radius: over a track's lower two thirds (above them a post's track
@@ -50,6 +51,10 @@ constexpr double POLE_RADIUS_SPREAD = 0.025;
 constexpr double POST_TOP_CHANGE = 0.15;
 constexpr std::size_t POST_TOP_WINDOW = 5;
 constexpr double POST_TOP_OFF_AXIS = 0.5;
+// The trunk's track is measured again past another column from this many circles below the
+// first that comes within the band of the column's surface: the circles just below it are
+// already drawn towards the column.
+constexpr int COLUMN_CLIMB_BACKOFF_SLICES = 2;
 constexpr double RETRY_WIDTH = 1.6;     // first circle / start radius above which a low track
                                         // is retried
 constexpr double VOTING_HEIGHT = 0.75;  // share of its trunk's height a track must climb to vote
@@ -387,23 +392,20 @@ int representative(const std::vector<std::optional<TrackedTrunk>>& tracks, const
   return chosen;
 }
 
-/// Whether more than half of a group's voters read as poles (isPole).
+/// Whether one of a group's voters reads as a pole (isPole).
 bool readsAsPost(const std::vector<std::optional<TrackedTrunk>>& tracks,
                  const std::vector<char>& voters) {
-  std::size_t poles = 0, all = 0;
   for (std::size_t k = 0; k < tracks.size(); ++k) {
-    if (!voters[k])
-      continue;
-    ++all;
-    poles += isPole(*tracks[k]) ? 1 : 0;
+    if (voters[k] && isPole(*tracks[k]))
+      return true;
   }
-  return 2 * poles > all;
+  return false;
 }
 
 /// A group's score: the median of its voting tracks' (only those that climb most of the
 /// group's height vote, since a track that stopped at a whorl low on the trunk has a small
-/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when more than half of
-/// them read as poles. Negative when it has no voter.
+/// shell and would drag its trunk below a neighbour's), at POLE_WEIGHT when one of them reads
+/// as a pole. Negative when it has no voter.
 double groupScore(const std::vector<std::optional<TrackedTrunk>>& tracks,
                   const std::vector<double>& scores, const std::vector<char>& voters) {
   std::vector<double> member_scores;
@@ -675,7 +677,45 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
   return out;
 }
 
+/// Whether p lies on or inside one of the columns' surfaces, within `band` (m) of it.
+bool onAColumn(const std::vector<const TrackedTrunk*>& columns, const Eigen::Vector3d& p,
+               double band) {
+  return std::any_of(columns.begin(), columns.end(), [&](const TrackedTrunk* c) {
+    const auto gap = surfaceGapAt(*c, p);
+    return gap && *gap <= band;
+  });
+}
+
+/// The index of the track's first circle that comes within `band` (m) of a column's surface
+/// (the two surfaces, not the centres), or the track's size.
+std::size_t firstCircleAtAColumn(const TrackedTrunk& track,
+                                 const std::vector<const TrackedTrunk*>& columns, double band) {
+  for (std::size_t k = 0; k < track.centers.size(); ++k) {
+    if (onAColumn(columns, track.centers[k], track.radii[k] + band))
+      return k;
+  }
+  return track.centers.size();
+}
+
 }  // namespace
+
+TrackedTrunk climbPastColumns(const Points& pts, TrackedTrunk track,
+                              const std::vector<const TrackedTrunk*>& columns, double band,
+                              const ModelerConfig& config) {
+  const std::size_t near = firstCircleAtAColumn(track, columns, band);
+  if (near >= track.centers.size() || near < static_cast<std::size_t>(COLUMN_CLIMB_BACKOFF_SLICES))
+    return track;
+  Points rest;
+  for (const auto& p : pts) {
+    if (!onAColumn(columns, p, band))
+      rest.push_back(p);
+  }
+  const PointIndex index(rest);
+  auto again = climbAgainFrom(rest, index, track, near - COLUMN_CLIMB_BACKOFF_SLICES, band, config);
+  if (!again || again->centers.back().z() < track.centers.back().z() - config.trunk.slice_height_m)
+    return track;
+  return std::move(*again);
+}
 
 void endAtPostTop(TrackedTrunk* t) {
   if (!keepsOneRadius(*t))
@@ -765,10 +805,20 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   if (chosen >= 0)
     tracks[chosen] =
         resumePastWhorlsAndForks(pts, index, std::move(*tracks[chosen]), threshold, config);
+  const std::vector<int> others =
+      chosen >= 0 ? otherColumns(tracks, starts, groups, chosen, threshold, frame)
+                  : std::vector<int>{};
+  if (!others.empty()) {
+    std::vector<const TrackedTrunk*> column_tracks;
+    for (const int k : others)
+      column_tracks.push_back(&*tracks[k]);
+    tracks[chosen] =
+        climbPastColumns(pts, std::move(*tracks[chosen]), column_tracks, threshold, config);
+  }
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);
   if (chosen < 0)
     return std::nullopt;
-  for (const int k : otherColumns(tracks, starts, groups, chosen, threshold, frame)) {
+  for (const int k : others) {
     (*report)[k].other_column = true;
     if (columns)
       columns->push_back(*tracks[k]);

@@ -167,7 +167,7 @@ TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, Tracke
 /// @brief The chosen trunk's track resumed past whorls (resumePastWhorls) and past a fork
 /// where it took a branch: a steep scaffold nearly as thick as the leader draws the circles
 /// onto itself, and the track ends where the branch does. When no whorl pulled it, the track is
-/// tried again from each of its circles up to 60 cm below its end off whose line beneath (the
+/// tried again from each of its circles up to 1 m below its end off whose line beneath (the
 /// six circles under it) the end lies, along that line from 10 cm above the circle; a climb is
 /// kept when it holds more circles than it drops (the leader above a fork is longer than the
 /// branch) and they are no thicker than the line's by more than the taper's 10 % swell (a
@@ -179,6 +179,18 @@ TrackedTrunk resumePastWhorls(const Points& pts, const PointIndex& index, Tracke
 TrackedTrunk resumePastWhorlsAndForks(const Points& pts, const PointIndex& index,
                                       TrackedTrunk track, double threshold,
                                       const ModelerConfig& config);
+
+/// @brief The track's first `kept` circles, climbed on from there along the line through the
+/// six circles beneath and resumed past whorls and forks (resumePastWhorlsAndForks): every
+/// circle from `kept` on is measured again, on `pts`, which may leave out what pulled the track
+/// aside (another column's surface).
+/// @param track ordered bottom to top
+/// @param kept circles kept, at least six and at most the track's
+/// @param threshold the circle band (m), as given to trackTrunk()
+/// @return the new track; nothing when `kept` is out of range or the climb finds no circle
+std::optional<TrackedTrunk> climbAgainFrom(const Points& pts, const PointIndex& index,
+                                           const TrackedTrunk& track, std::size_t kept,
+                                           double threshold, const ModelerConfig& config);
 
 /// @brief The trunk's neighbourhood reaches this many radii from its axis ...
 constexpr double TRUNK_REACH_RADII = 3.0;

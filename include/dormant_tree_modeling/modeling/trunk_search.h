@@ -82,6 +82,21 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
 std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTrunk>& columns,
                                   const TrackedTrunk& trunk, double band);
 
+/// @brief The trunk's track measured again past other upright columns: from two circles below
+/// the first that comes within `band` of a column's surface (their surfaces that near), climbed
+/// again (climbAgainFrom) on the points off every column's surface (farther than `band` outside
+/// it). A leader beside a post drifts onto the post's near side or ends where the post's arc
+/// fills its slices. The new climb is kept when it reaches within a slice of the old one's top:
+/// where a leader grows into its post, its points beside the post go with the post's, and the
+/// climb ends early or turns onto a scaffold.
+/// @param track the chosen trunk's track, bottom to top
+/// @param columns other columns' tracks (trackBestTrunk's `columns`)
+/// @param band the tracking band (m)
+/// @return the new track, or `track` when no column comes that near or the climb is not kept
+TrackedTrunk climbPastColumns(const Points& pts, TrackedTrunk track,
+                              const std::vector<const TrackedTrunk*>& columns, double band,
+                              const ModelerConfig& config);
+
 /// @brief Cuts each track that ran onto another column below the circle where it joined it,
 /// and empties one left with fewer than 3 circles. A track joins column b where its centre
 /// first lies inside b's surface, when the two stood clear of each other (their surfaces apart)
