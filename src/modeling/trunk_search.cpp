@@ -677,19 +677,23 @@ std::vector<int> otherColumns(const std::vector<std::optional<TrackedTrunk>>& tr
   return out;
 }
 
-/// Whether p lies on or inside one of the columns' surfaces, within `band` (m) of it.
-bool onAColumn(const std::vector<const TrackedTrunk*>& columns, const Eigen::Vector3d& p,
-               double band) {
-  return std::any_of(columns.begin(), columns.end(), [&](const TrackedTrunk* c) {
-    const auto gap = surfaceGapAt(*c, p);
-    return gap && *gap <= band;
-  });
+/// Whether p lies on or inside a track's surface, within `band` (m) of it, at a height the
+/// track spans.
+bool nearSurface(const TrackedTrunk& track, const Eigen::Vector3d& p, double band) {
+  const auto gap = surfaceGapAt(track, p);
+  return gap && *gap <= band;
+}
+
+/// Whether p lies near one of the columns' surfaces (nearSurface).
+bool onAColumn(const std::vector<TrackedTrunk>& columns, const Eigen::Vector3d& p, double band) {
+  return std::any_of(columns.begin(), columns.end(),
+                     [&](const TrackedTrunk& c) { return nearSurface(c, p, band); });
 }
 
 /// The index of the track's first circle that comes within `band` (m) of a column's surface
 /// (the two surfaces, not the centres), or the track's size.
 std::size_t firstCircleAtAColumn(const TrackedTrunk& track,
-                                 const std::vector<const TrackedTrunk*>& columns, double band) {
+                                 const std::vector<TrackedTrunk>& columns, double band) {
   for (std::size_t k = 0; k < track.centers.size(); ++k) {
     if (onAColumn(columns, track.centers[k], track.radii[k] + band))
       return k;
@@ -700,7 +704,7 @@ std::size_t firstCircleAtAColumn(const TrackedTrunk& track,
 }  // namespace
 
 TrackedTrunk climbPastColumns(const Points& pts, TrackedTrunk track,
-                              const std::vector<const TrackedTrunk*>& columns, double band,
+                              const std::vector<TrackedTrunk>& columns, double band,
                               const ModelerConfig& config) {
   const std::size_t near = firstCircleAtAColumn(track, columns, band);
   if (near >= track.centers.size() || near < static_cast<std::size_t>(COLUMN_CLIMB_BACKOFF_SLICES))
@@ -808,21 +812,19 @@ std::optional<TrackedTrunk> trackBestTrunk(const Points& pts, const PointIndex& 
   const std::vector<int> others =
       chosen >= 0 ? otherColumns(tracks, starts, groups, chosen, threshold, frame)
                   : std::vector<int>{};
-  if (!others.empty()) {
-    std::vector<const TrackedTrunk*> column_tracks;
-    for (const int k : others)
-      column_tracks.push_back(&*tracks[k]);
+  std::vector<TrackedTrunk> column_tracks;
+  for (const int k : others)
+    column_tracks.push_back(*tracks[k]);
+  if (!column_tracks.empty())
     tracks[chosen] =
         climbPastColumns(pts, std::move(*tracks[chosen]), column_tracks, threshold, config);
-  }
   *report = candidateReport(starts, tracks, scores, groups.group, chosen);
   if (chosen < 0)
     return std::nullopt;
-  for (const int k : others) {
+  for (const int k : others)
     (*report)[k].other_column = true;
-    if (columns)
-      columns->push_back(*tracks[k]);
-  }
+  if (columns)
+    columns->insert(columns->end(), column_tracks.begin(), column_tracks.end());
   return std::move(tracks[chosen]);
 }
 
@@ -832,12 +834,8 @@ std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTr
   if (columns.empty())
     return on;
   parallelFor(static_cast<int>(pts.size()), [&](int i) {
-    const auto near = [&](const TrackedTrunk& track) {
-      const auto gap = surfaceGapAt(track, pts[i]);
-      return gap && *gap <= band;
-    };
     // The trunk's gap only for points on a column: most points are near none.
-    on[i] = std::any_of(columns.begin(), columns.end(), near) && !near(trunk);
+    on[i] = onAColumn(columns, pts[i], band) && !nearSurface(trunk, pts[i], band);
   });
   return on;
 }

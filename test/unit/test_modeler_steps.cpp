@@ -519,7 +519,7 @@ TEST(TrunkSearch, ATrackThatDriftedOntoAPostIsMeasuredAgainPastIt) {
   }
   const double band = 2.5 * s.sigma;
   ModelerConfig config;
-  const TrackedTrunk again = climbPastColumns(s.pts, drifted, {&s.post}, band, config);
+  const TrackedTrunk again = climbPastColumns(s.pts, drifted, {s.post}, band, config);
   double worst = 0.0;
   for (const auto& c : again.centers)
     worst = std::max(worst, (c.head<2>() - s.axisAt(c.z())).norm());

@@ -94,7 +94,7 @@ std::vector<char> pointsOnColumns(const Points& pts, const std::vector<TrackedTr
 /// @param band the tracking band (m)
 /// @return the new track, or `track` when no column comes that near or the climb is not kept
 TrackedTrunk climbPastColumns(const Points& pts, TrackedTrunk track,
-                              const std::vector<const TrackedTrunk*>& columns, double band,
+                              const std::vector<TrackedTrunk>& columns, double band,
                               const ModelerConfig& config);
 
 /// @brief Cuts each track that ran onto another column below the circle where it joined it,
