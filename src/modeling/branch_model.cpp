@@ -221,6 +221,8 @@ const char* branchRejectionText(BranchRejection reason) {
       return "thicker than the trunk";
     case BranchRejection::MISSES_THE_TRUNK:
       return "misses the trunk";
+    case BranchRejection::SPANS_THE_TRUNK:
+      return "spans the trunk";
     case BranchRejection::NOT_AT_THE_SURFACE:
       return "not at the surface";
     case BranchRejection::TOO_SHORT:

@@ -142,6 +142,8 @@ class BranchSearch {
                                         double gap) const;
   std::optional<Verdict> checkPlace(const Candidate& candidate, const Cylinder& fit,
                                     const Eigen::Vector3d& attachment) const;
+  bool spansTheTrunk(const Cylinder& fit, const Cylinder& seg, const NearPart& near,
+                     const std::vector<int>& inliers) const;
   bool reachesSurface(const NearPart& near) const;
   void accept(const Candidate& candidate, const NearPart& near, const Cylinder& fit,
               double wood_radius, const std::vector<int>& inliers,

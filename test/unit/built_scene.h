@@ -32,6 +32,11 @@ inline void addCylinder(Points& pts, const Eigen::Vector3d& base, const Eigen::V
   }
 }
 
+/// The angle between two lines (undirected), in degrees.
+inline double lineAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
 /// The trunk of a built scene: its first trunk_points points, a vertical 3 cm cylinder from
 /// z 0 to 1.5 m, modeled at 2 mm noise.
 struct BuiltTrunk {

@@ -16,6 +16,7 @@ namespace {
 
 using test::addCylinder;
 using test::buildTrunk;
+using test::lineAngleDeg;
 
 constexpr double DEG = M_PI / 180.0;
 const Eigen::Vector3d SURFACE(0.03, 0, 0.9);  // where the primary leaves the 3 cm trunk
@@ -37,10 +38,6 @@ Points forkedScene(double arm_azimuth_deg, std::size_t* trunk_points) {
   addCylinder(pts, SURFACE, OUT, 0.006, 0.20);
   addCylinder(pts, SURFACE + FORK_OFF * OUT, turned(arm_azimuth_deg), 0.005, 0.30);
   return pts;
-}
-
-double lineAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) / DEG;
 }
 
 TEST(BranchFork, APrimaryIsFittedAlongItselfNotAlongItsSideArm) {

@@ -32,6 +32,7 @@ enum class BranchRejection {
   POINTS_DOWN,               ///< the fit dives below branches.min_elevation_deg
   THICKER_THAN_THE_TRUNK,    ///< wider than branches.max_diameter_ratio of its trunk segment
   MISSES_THE_TRUNK,          ///< the fit's axis passes the trunk axis beyond branches.axis_gap_m
+  SPANS_THE_TRUNK,           ///< the fit's points lie on both sides of the trunk
   NOT_AT_THE_SURFACE,        ///< its points start away from the trunk with air between
   TOO_SHORT,                 ///< shorter than branches.min_length_m
   TOO_LOW,                   ///< attached below branches.min_height_m
@@ -43,8 +44,8 @@ enum class BranchRejection {
 
 /// @brief The words for a reason, as logs and `tree_model -v` print them ("too few points",
 /// "no fit", "off its ray", "not radial", "points down", "thicker than the trunk", "misses the
-/// trunk", "not at the surface", "too short", "too low", "a wire", "duplicate", "few points
-/// for this tree", "remainder not searched").
+/// trunk", "spans the trunk", "not at the surface", "too short", "too low", "a wire", "duplicate",
+/// "few points for this tree", "remainder not searched").
 const char* branchRejectionText(BranchRejection reason);
 
 /// @brief A branch candidate that was turned down, and why (for diagnostics).
