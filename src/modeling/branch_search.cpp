@@ -89,6 +89,15 @@ double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
 }
 
+/// The fit's heading seen along the trunk (a unit vector), when the fit runs across the trunk
+/// by more than MIN_ACROSS_SHARE of its length; a near-vertical fit has none.
+std::optional<Eigen::Vector3d> headingAcrossTheTrunk(const Cylinder& fit, const Cylinder& seg) {
+  const Eigen::Vector3d across = fit.axis - fit.axis.dot(seg.axis) * seg.axis;
+  if (across.norm() <= MIN_ACROSS_SHARE)
+    return std::nullopt;
+  return across.normalized();
+}
+
 /// Closest points between two lines p + t u and q + s v: returns the distance between the
 /// lines and, in on_second, the point on the second.
 double lineGap(const Eigen::Vector3d& p, const Eigen::Vector3d& u, const Eigen::Vector3d& q,
@@ -512,10 +521,9 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidat
                                                                   const Direction& guess,
                                                                   double gap) const {
   const ModelerConfig& config = context_.config;
-  const Eigen::Vector3d across = fit.axis - fit.axis.dot(seg.axis) * seg.axis;
+  const auto heading = headingAcrossTheTrunk(fit, seg);
   const bool sideways =
-      across.norm() > MIN_ACROSS_SHARE &&
-      angleBetween(across.normalized(), guess.radial) > config.branches.max_azimuth_deg * DEG;
+      heading && angleBetween(*heading, guess.radial) > config.branches.max_azimuth_deg * DEG;
   const bool off_ray = candidate.ray && lineAngle(fit.axis, *candidate.ray) > RAY_AGREEMENT;
   if (off_ray)
     return Verdict{BranchRejection::OFF_ITS_RAY, true};
@@ -541,13 +549,12 @@ std::optional<BranchSearch::Verdict> BranchSearch::checkDirection(const Candidat
 /// A near-vertical fit has no side to be on.
 bool BranchSearch::spansTheTrunk(const Cylinder& fit, const Cylinder& seg, const NearPart& near,
                                  const std::vector<int>& inliers) const {
-  Eigen::Vector3d across = fit.axis - fit.axis.dot(seg.axis) * seg.axis;
-  if (across.norm() <= MIN_ACROSS_SHARE || inliers.empty())
+  const auto heading = headingAcrossTheTrunk(fit, seg);
+  if (!heading || inliers.empty())
     return false;
-  across.normalize();
   const double behind = seg.radius + context_.bands.inner_gap;
   const auto n = std::count_if(inliers.begin(), inliers.end(), [&](int i) {
-    return (near.pts[i] - seg.center).dot(across) < -behind;
+    return (near.pts[i] - seg.center).dot(*heading) < -behind;
   });
   return static_cast<double>(n) > MAX_SHARE_BEHIND_THE_TRUNK * static_cast<double>(inliers.size());
 }
