@@ -313,26 +313,14 @@ std::vector<int> pointsNearAxis(const Points& pts, const std::vector<Eigen::Vect
 std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<int>& region,
                                           const TrunkModel& trunk, const ModelerConfig& config,
                                           std::vector<PointClass>* classes) {
-  std::vector<double> region_s(region.size());
-  parallelFor(static_cast<int>(region.size()),
-              [&](int k) { region_s[k] = trunk.centerline.project(pts[region[k]]); });
-  const double band = std::max(config.fit.cylinder_threshold_m, noiseBand(trunk.noise_sigma));
-  std::vector<CylinderModel> out;
-  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
-    const Cylinder& c = trunk.cylinders[i];
-    std::size_t inliers = 0, total = 0;
-    for (std::size_t j = 0; j < region.size(); ++j) {
-      const double s = region_s[j];
-      if (s < trunk.cylinder_ranges[i].first || s >= trunk.cylinder_ranges[i].second)
-        continue;
-      ++total;
-      if (std::abs(axisDistance(c, pts[region[j]]) - c.radius) < band) {
-        ++inliers;
-        (*classes)[region[j]] = PointClass::TRUNK;
-      }
-    }
-    out.push_back(toModel(c, static_cast<int>(i), inliers, total));
+  const TrunkMembership m = trunkMembership(pts, region, trunk, trunkSurfaceBand(trunk, config));
+  for (std::size_t k = 0; k < region.size(); ++k) {
+    if (m.on_surface[k])
+      (*classes)[region[k]] = PointClass::TRUNK;
   }
+  std::vector<CylinderModel> out;
+  for (std::size_t i = 0; i < trunk.cylinders.size(); ++i)
+    out.push_back(toModel(trunk.cylinders[i], static_cast<int>(i), m.inliers[i], m.points[i]));
   return out;
 }
 

@@ -46,8 +46,9 @@ constexpr double TAPER_ABOVE_NOISY = 1.0;
 // three slices, as the running median of expectedRadii.
 constexpr double AXIS_RADIUS_WINDOW = 0.15;
 // A slice circle's centre lies within this many local radii of the centreline: the circle
-// holds the axis.
-constexpr double SLICE_CENTRE_RADII = 1.0;
+// holds the axis. A circle through the leader and scaffolds on one side of it holds more
+// returns than the leader's own, and its centre lies between them, a radius or more off.
+constexpr double SLICE_CENTRE_RADII = 0.3;
 // The range noise is read on slices whose circle is at most this many times the track's local
 // radius. Honest slices read within a fifth of it; a circle through a whorl's branch bases or
 // around a scaffold beside the leader reads 1.5-2.5 times it, and its residuals measure the
@@ -1165,6 +1166,26 @@ void applyTaperProfile(TrunkModel& trunk, const ModelerConfig& config) {
   }
 }
 
+/// Drops the trunk's top cylinders while the highest holds on its surface less than
+/// MIN_TRUNK_SURFACE_SHARE of the returns in its stretch: there the trunk has run out.
+void endWhereTheSurfaceEnds(const Points& pts, const std::vector<int>& region,
+                            const ModelerConfig& config, TrunkModel& trunk) {
+  const TrunkMembership m = trunkMembership(pts, region, trunk, trunkSurfaceBand(trunk, config));
+  std::size_t kept = trunk.cylinders.size();
+  while (kept > 1 && static_cast<double>(m.inliers[kept - 1]) <
+                         MIN_TRUNK_SURFACE_SHARE * static_cast<double>(m.points[kept - 1]))
+    --kept;
+  if (kept == trunk.cylinders.size())
+    return;
+  trunk.cylinders.resize(kept);
+  trunk.cylinder_ranges.resize(kept);
+  const double top = trunk.cylinder_ranges.back().second;
+  while (trunk.partitions.size() > 1 && trunk.partitions.back() > top + 1e-9)
+    trunk.partitions.pop_back();
+  if (trunk.partitions.back() < top - 1e-9)
+    trunk.partitions.push_back(top);
+}
+
 /// Slices on the initial axis, then CENTERLINE_ROUNDS rounds of refining the centreline on
 /// their circles and slicing again.
 SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
@@ -1187,6 +1208,38 @@ SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
 }
 
 }  // namespace
+
+double trunkSurfaceBand(const TrunkModel& trunk, const ModelerConfig& config) {
+  return std::max(config.fit.cylinder_threshold_m, noiseBand(trunk.noise_sigma));
+}
+
+TrunkMembership trunkMembership(const Points& pts, const std::vector<int>& region,
+                                const TrunkModel& trunk, double band) {
+  TrunkMembership out;
+  out.cylinder.assign(region.size(), -1);
+  out.on_surface.assign(region.size(), 0);
+  parallelFor(static_cast<int>(region.size()), [&](int k) {
+    const Eigen::Vector3d& p = pts[region[k]];
+    const double s = trunk.centerline.project(p);
+    for (std::size_t i = 0; i < trunk.cylinders.size(); ++i) {
+      if (s >= trunk.cylinder_ranges[i].first && s < trunk.cylinder_ranges[i].second) {
+        const Cylinder& c = trunk.cylinders[i];
+        out.cylinder[k] = static_cast<int>(i);
+        out.on_surface[k] = std::abs(axisDistance(c, p) - c.radius) < band;
+        break;
+      }
+    }
+  });
+  out.points.assign(trunk.cylinders.size(), 0);
+  out.inliers.assign(trunk.cylinders.size(), 0);
+  for (std::size_t k = 0; k < region.size(); ++k) {
+    if (out.cylinder[k] >= 0) {
+      ++out.points[out.cylinder[k]];
+      out.inliers[out.cylinder[k]] += out.on_surface[k];
+    }
+  }
+  return out;
+}
 
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
@@ -1246,6 +1299,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     applyTaperProfile(trunk, config);
   if (config.fit.constrain)
     boundByTheSegmentBelow(trunk.cylinders);
+  endWhereTheSurfaceEnds(pts, region, config, trunk);
   return trunk;
 }
 

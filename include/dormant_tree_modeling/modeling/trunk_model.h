@@ -204,6 +204,31 @@ inline double trunkReach(double radius) {
   return std::max(TRUNK_REACH_RADII * radius, radius + TRUNK_REACH_MIN_GAP_M);
 }
 
+/// @brief A trunk cylinder is trunk only where its surface holds at least this share of the
+/// returns in its stretch of the centreline. Where a track runs on past the trunk's top, into
+/// a real crown's forks, the last cylinders stand among the stems: 0-18 % on the real
+/// adtree_tree1 scan, 0.2-0.4 m off its trunk's axis.
+constexpr double MIN_TRUNK_SURFACE_SHARE = 0.15;
+
+/// @brief Where each region point lies on the trunk: the cylinder whose arc-length range
+/// holds its projection on the centreline (-1: none), and whether it lies within the surface
+/// band of that cylinder; and per cylinder, how many do.
+struct TrunkMembership {
+  std::vector<int> cylinder;         ///< per region point
+  std::vector<char> on_surface;      ///< per region point
+  std::vector<std::size_t> points;   ///< per cylinder: region points in its stretch
+  std::vector<std::size_t> inliers;  ///< per cylinder: those on its surface
+};
+
+/// @brief The band (m) about a trunk cylinder's surface that its returns lie in: the fit's
+/// cylinder threshold or the band of the estimated range noise, the wider.
+double trunkSurfaceBand(const TrunkModel& trunk, const ModelerConfig& config);
+
+/// @brief Each region point's cylinder and whether it lies on its surface (all cores).
+/// @param band half-width of the surface band (m), trunkSurfaceBand()
+TrunkMembership trunkMembership(const Points& pts, const std::vector<int>& region,
+                                const TrunkModel& trunk, double band);
+
 /// @brief Algorithm 3 steps 1-4 on the trunk region.
 
 /// @param pts the modeled cloud
@@ -214,8 +239,10 @@ inline double trunkReach(double radius) {
 ///        slice circles stay within 0.3x..2.5x of it
 /// @param axis_radii the radius measured at each initial axis point (a track's circles), or
 ///        none; where given, a slice's circle stays within 0.3x..2.5x of the median of the
-///        radii within 15 cm of it, and its centre within one such radius of the centreline
+///        radii within 15 cm of it, and its centre within 0.3 such radii of the centreline
 ///        (the noise estimate still reads slices bounded by initial_radius alone)
+/// @return the trunk up to its highest cylinder whose surface holds MIN_TRUNK_SURFACE_SHARE of
+///         its stretch's returns (the lowest cylinder is always kept)
 /// @throws Error NO_TRUNK when no trunk cylinder can be fitted
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
