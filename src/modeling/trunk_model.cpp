@@ -1297,9 +1297,11 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");
   if (config.noise.correct_bias && config.trunk.taper_profile)
     applyTaperProfile(trunk, config);
+  // Judged before the bound below, which may take a segment's radius off its returns (a
+  // swelling) without it ceasing to be trunk.
+  endWhereTheSurfaceEnds(pts, region, config, trunk);
   if (config.fit.constrain)
     boundByTheSegmentBelow(trunk.cylinders);
-  endWhereTheSurfaceEnds(pts, region, config, trunk);
   return trunk;
 }
 

@@ -242,7 +242,8 @@ TrunkMembership trunkMembership(const Points& pts, const std::vector<int>& regio
 ///        radii within 15 cm of it, and its centre within 0.3 such radii of the centreline
 ///        (the noise estimate still reads slices bounded by initial_radius alone)
 /// @return the trunk up to its highest cylinder whose surface holds MIN_TRUNK_SURFACE_SHARE of
-///         its stretch's returns (the lowest cylinder is always kept)
+///         its stretch's returns, judged before a segment's radius is bounded by the one below
+///         (the lowest cylinder is always kept)
 /// @throws Error NO_TRUNK when no trunk cylinder can be fitted
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
