@@ -227,6 +227,16 @@ Eigen::Vector3d crookedAxisAt(double z) {
   return {sway, 0.0, z};
 }
 
+/// 48 points on a circle of `radius` about `centre`, square to the unit direction `t`.
+void addRingSquareTo(Points& pts, const Eigen::Vector3d& centre, const Eigen::Vector3d& t,
+                     double radius) {
+  const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
+  for (int k = 0; k < 48; ++k) {
+    const double phi = 2.0 * M_PI * k / 48;
+    pts.push_back(centre + radius * (std::cos(phi) * u + std::sin(phi) * v));
+  }
+}
+
 /// Rings around the crooked axis, square to it, every 5 mm, tapering from 4 cm to 1.5 cm.
 Points crookedTrunk() {
   Points pts;
@@ -234,12 +244,7 @@ Points crookedTrunk() {
   for (double z = 0.0; z <= CROOKED_HEIGHT; z += step) {
     const Eigen::Vector3d c = crookedAxisAt(z);
     const Eigen::Vector3d t = (crookedAxisAt(z + step) - c).normalized();
-    const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
-    const double r = 0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT;
-    for (int k = 0; k < 48; ++k) {
-      const double phi = 2.0 * M_PI * k / 48;
-      pts.push_back(c + r * (std::cos(phi) * u + std::sin(phi) * v));
-    }
+    addRingSquareTo(pts, c, t, 0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT);
   }
   return pts;
 }
@@ -289,14 +294,8 @@ Points forkedTrunk() {
     const double azimuth = 2.0 * M_PI * stem / FORK_STEMS;
     const Eigen::Vector3d t(std::sin(lean) * std::cos(azimuth), std::sin(lean) * std::sin(azimuth),
                             std::cos(lean));
-    const Eigen::Vector3d u = t.unitOrthogonal(), v = t.cross(u);
-    for (double s = 0.0; FORK_M + s * t.z() <= HEIGHT; s += 0.005) {
-      const Eigen::Vector3d c = Eigen::Vector3d(0.0, 0.0, FORK_M) + s * t;
-      for (int k = 0; k < 48; ++k) {
-        const double phi = 2.0 * M_PI * k / 48;
-        pts.push_back(c + FORK_STEM_RADIUS_M * (std::cos(phi) * u + std::sin(phi) * v));
-      }
-    }
+    for (double s = 0.0; FORK_M + s * t.z() <= HEIGHT; s += 0.005)
+      addRingSquareTo(pts, Eigen::Vector3d(0.0, 0.0, FORK_M) + s * t, t, FORK_STEM_RADIUS_M);
   }
   return pts;
 }
