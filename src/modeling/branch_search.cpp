@@ -310,9 +310,10 @@ void BranchSearch::examine(const Candidate& candidate) {
     if (spansTheTrunk(*cyl, seg, near, inliers))
       return reject(candidate, near.segment, {BranchRejection::SPANS_THE_TRUNK, true});
     reaches_surface = reachesSurface(near);
-    // A branch crossing this one near the trunk may have taken its near part out with it.
+    // A branch crossing this one near the trunk may have taken its near part out with it;
+    // its way back then leads into the trunk, which a side arm's does not.
     if (!reaches_surface &&
-        !(config.branches.keep_cut_off &&
+        !(config.branches.keep_cut_off && !missesLikeASideArm(*cyl, seg) &&
           filledToSurface(*cyl, seg, context_.index, context_.bands.inner_gap, near.nearest_gap,
                           cyl->radius + context_.bands.threshold)))
       return reject(candidate, near.segment, {BranchRejection::NOT_AT_THE_SURFACE, true});
