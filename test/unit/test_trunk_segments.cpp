@@ -40,6 +40,30 @@ Points taperedTrunk() {
   return pts;
 }
 
+/// A track's circles, 5 cm apart from the ground up to `height`: centred on axis_at(z), of
+/// radius radius_at(z).
+struct Track {
+  std::vector<Eigen::Vector3d> axis;
+  std::vector<double> radii;
+};
+
+template <typename AxisAt, typename RadiusAt>
+Track trackAlong(double height, AxisAt axis_at, RadiusAt radius_at) {
+  Track track;
+  for (double z = 0.0; z <= height + 1e-9; z += 0.05) {
+    track.axis.push_back(axis_at(z));
+    track.radii.push_back(radius_at(z));
+  }
+  return track;
+}
+
+/// The track up the straight tapered trunk's axis, of radius radius_at(z).
+template <typename RadiusAt>
+Track straightTrack(RadiusAt radius_at) {
+  return trackAlong(
+      HEIGHT, [](double z) { return Eigen::Vector3d(0.0, 0.0, z); }, radius_at);
+}
+
 /// Every point of the cloud as the trunk region.
 std::vector<int> allOf(const Points& pts) {
   std::vector<int> region(pts.size());
@@ -159,15 +183,11 @@ TEST(TrunkSegments, SlicesFollowTheTrackedRadiusPastScaffoldsAroundTheTop) {
   const std::vector<int> region = allOf(pts);
   const ModelerConfig config = idealScanner();
   // A track's circles along the axis: the taper, 5 cm apart.
-  std::vector<Eigen::Vector3d> axis;
-  std::vector<double> radii;
-  for (double z = 0.0; z <= HEIGHT + 1e-9; z += 0.05) {
-    axis.emplace_back(0.0, 0.0, z);
-    radii.push_back(taper(z));
-  }
+  const Track track = straightTrack(taper);
   const double median_radius = taper(0.5 * HEIGHT);
-  const TrunkModel one = modelTrunk(pts, region, axis, median_radius, config);
-  const TrunkModel tracked = modelTrunk(pts, region, axis, median_radius, config, radii);
+  const TrunkModel one = modelTrunk(pts, region, track.axis, median_radius, config);
+  const TrunkModel tracked =
+      modelTrunk(pts, region, track.axis, median_radius, config, track.radii);
   std::printf(
       "[ INFO ] above the scaffolds the radius is off by %.1f mm with one radius for the trunk, "
       "%.1f mm with the track's\n",
@@ -196,14 +216,9 @@ TEST(TrunkSegments, TheCentrelineKeepsToTheLeaderBesideScaffoldsOnOneSide) {
   // its centre lies between them, about a radius off the centreline: slices keep their
   // circles' centres within 0.3 radii of it.
   const Points pts = trunkWithScaffoldsOnOneSide();
-  std::vector<Eigen::Vector3d> axis;
-  std::vector<double> radii;
-  for (double z = 0.0; z <= HEIGHT + 1e-9; z += 0.05) {
-    axis.emplace_back(0.0, 0.0, z);
-    radii.push_back(taper(z));
-  }
+  const Track track = straightTrack(taper);
   const TrunkModel trunk =
-      modelTrunk(pts, allOf(pts), axis, taper(0.5 * HEIGHT), idealScanner(), radii);
+      modelTrunk(pts, allOf(pts), track.axis, taper(0.5 * HEIGHT), idealScanner(), track.radii);
   double line_worst = 0.0;
   for (double s = 0.0; s <= trunk.centerline.length(); s += 0.01) {
     const Eigen::Vector3d p = trunk.centerline.pointAt(s);
@@ -227,6 +242,11 @@ Eigen::Vector3d crookedAxisAt(double z) {
   return {sway, 0.0, z};
 }
 
+/// The crooked leader's radius, tapering from 4 cm at the ground to 1.5 cm at its top.
+double crookedRadiusAt(double z) {
+  return 0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT;
+}
+
 /// 48 points on a circle of `radius` about `centre`, square to the unit direction `t`.
 void addRingSquareTo(Points& pts, const Eigen::Vector3d& centre, const Eigen::Vector3d& t,
                      double radius) {
@@ -244,7 +264,7 @@ Points crookedTrunk() {
   for (double z = 0.0; z <= CROOKED_HEIGHT; z += step) {
     const Eigen::Vector3d c = crookedAxisAt(z);
     const Eigen::Vector3d t = (crookedAxisAt(z + step) - c).normalized();
-    addRingSquareTo(pts, c, t, 0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT);
+    addRingSquareTo(pts, c, t, crookedRadiusAt(z));
   }
   return pts;
 }
@@ -253,13 +273,9 @@ TEST(TrunkSegments, TheCylindersFollowACrookedLeader) {
   // The track's circles lie on the axis, 5 cm apart. The centreline through them is local:
   // no one curve over the whole trunk, which cuts a sway's bends.
   const Points pts = crookedTrunk();
-  std::vector<Eigen::Vector3d> axis;
-  std::vector<double> radii;
-  for (double z = 0.0; z <= CROOKED_HEIGHT + 1e-9; z += 0.05) {
-    axis.push_back(crookedAxisAt(z));
-    radii.push_back(0.04 + (0.015 - 0.04) * z / CROOKED_HEIGHT);
-  }
-  const TrunkModel trunk = modelTrunk(pts, allOf(pts), axis, 0.03, idealScanner(), radii);
+  const Track track = trackAlong(CROOKED_HEIGHT, crookedAxisAt, crookedRadiusAt);
+  const TrunkModel trunk =
+      modelTrunk(pts, allOf(pts), track.axis, 0.03, idealScanner(), track.radii);
   ASSERT_GE(trunk.cylinders.size(), 4u);
   double line_worst = 0.0, worst = 0.0;
   const Centerline& line = trunk.centerline;
@@ -304,14 +320,9 @@ TEST(TrunkSegments, TheTrunkEndsWhereItForks) {
   // The track runs on up between the stems, as the real adtree_tree1 scan's ran into its
   // crown: cylinders past the fork stand between the stems and hold few of their returns.
   const Points pts = forkedTrunk();
-  std::vector<Eigen::Vector3d> axis;
-  std::vector<double> radii;
-  for (double z = 0.0; z <= HEIGHT + 1e-9; z += 0.05) {
-    axis.emplace_back(0.0, 0.0, z);
-    radii.push_back(taper(std::min(z, FORK_M)));
-  }
+  const Track track = straightTrack([](double z) { return taper(std::min(z, FORK_M)); });
   const TrunkModel trunk =
-      modelTrunk(pts, allOf(pts), axis, taper(0.5 * FORK_M), idealScanner(), radii);
+      modelTrunk(pts, allOf(pts), track.axis, taper(0.5 * FORK_M), idealScanner(), track.radii);
   ASSERT_FALSE(trunk.cylinders.empty());
   const TrunkMembership m =
       trunkMembership(pts, allOf(pts), trunk, trunkSurfaceBand(trunk, idealScanner()));
@@ -343,19 +354,14 @@ TEST(TrunkNoise, TheRangeNoiseIsReadOffTheSlicesAroundScaffolds) {
   // 4 mm of noise on the trunk of the scaffolds' test, alone and with its rods: slices around
   // the rods read a circle through them, whose residuals are the misfit, not the noise.
   const double sigma = 0.004;
-  std::vector<Eigen::Vector3d> axis;
-  std::vector<double> radii;
-  for (double z = 0.0; z <= HEIGHT + 1e-9; z += 0.05) {
-    axis.emplace_back(0.0, 0.0, z);
-    radii.push_back(taper(z));
-  }
+  const Track track = straightTrack(taper);
   ModelerConfig config;
   config.trunk_calibration = RadiusCalibration{};
   const Points alone = radialNoise(taperedTrunk(), sigma, 3);
   const Points rods = radialNoise(trunkWithRodsAroundItsTop(), sigma, 3);
   const double r = taper(0.5 * HEIGHT);
-  const TrunkModel a = modelTrunk(alone, allOf(alone), axis, r, config, radii);
-  const TrunkModel b = modelTrunk(rods, allOf(rods), axis, r, config, radii);
+  const TrunkModel a = modelTrunk(alone, allOf(alone), track.axis, r, config, track.radii);
+  const TrunkModel b = modelTrunk(rods, allOf(rods), track.axis, r, config, track.radii);
   std::printf("[ INFO ] noise read %.2f mm alone, %.2f mm with the rods (every slice: %.2f mm)\n",
               1000 * a.noise_sigma, 1000 * b.noise_sigma, 1000 * b.search_sigma);
   EXPECT_NEAR(b.noise_sigma, a.noise_sigma, 0.1 * a.noise_sigma);
