@@ -127,8 +127,15 @@ class Pool {
   bool stop_ = false;
 };
 
+/// The machine's hardware threads, read once: std::thread::hardware_concurrency reads sysfs on
+/// every call, and parallelFor is called thousands of times per model.
+int hardwareThreads() {
+  static const int threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return threads;
+}
+
 Pool& pool() {
-  static Pool instance(std::max(1, static_cast<int>(std::thread::hardware_concurrency()) - 1));
+  static Pool instance(std::max(1, hardwareThreads() - 1));
   return instance;
 }
 
@@ -137,7 +144,7 @@ Pool& pool() {
 void parallelFor(int n, const std::function<void(int)>& fn, int threads) {
   if (n <= 0)
     return;
-  int workers = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
+  int workers = threads > 0 ? threads : hardwareThreads();
   workers = std::clamp(workers, 1, n);
   Job job;
   job.n = n;
