@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -114,12 +115,17 @@ std::pair<double, double> range(const YAML::Node& n, const std::string& key,
   return {v[0], v[1]};
 }
 
+/// The values as a YAML list, each the shortest decimal that reads back as the same double, so
+/// that a file written and loaded again is the calibration that was measured: where a beam's
+/// table is nearly flat, its inversion turns micrometres of rounding into millimetres.
 std::string list(const std::vector<double>& v) {
   std::string s = "[";
   char buf[32];
   for (std::size_t i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof(buf), "%s%.5f", i ? ", " : "", v[i]);
-    s += buf;
+    if (i)
+      s += ", ";
+    const auto end = std::to_chars(buf, buf + sizeof(buf), v[i]).ptr;
+    s.append(buf, end);
   }
   return s + "]";
 }

@@ -160,29 +160,29 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
     return t;
   };
   EXPECT_EQ(code("tree_modeler:\n  psi_t: 60\n"), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(replaced("radii_m: [0.01000, 0.05000]", "radii_m: [0.05000, 0.01000]")),
+  EXPECT_EQ(code(replaced("radii_m: [0.01, 0.05]", "radii_m: [0.05, 0.01]")),
             ErrorCode::INVALID_ARGUMENT);
-  EXPECT_EQ(code(replaced("bias_m: [0.00300", "bias_m: [0.30000")), ErrorCode::INVALID_ARGUMENT);
+  EXPECT_EQ(code(replaced("bias_m: [0.003", "bias_m: [0.3")), ErrorCode::INVALID_ARGUMENT);
   EXPECT_EQ(code(replaced("covers:", "coverage:")), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(replaced("noise_m: [0.00600]", "noise_m: six")), ErrorCode::PARSE_ERROR);
-  EXPECT_EQ(code(replaced("noise_m: [0.00700, 0.00600]", "noise_m: [0.00700]")),
+  EXPECT_EQ(code(replaced("noise_m: [0.006]", "noise_m: six")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(replaced("noise_m: [0.007, 0.006]", "noise_m: [0.007]")),
             ErrorCode::INVALID_ARGUMENT);
-  EXPECT_EQ(code(replaced("noise_m: [0.00700, 0.00600]", "noise_m: [0.00700, 0.00000]")),
+  EXPECT_EQ(code(replaced("noise_m: [0.007, 0.006]", "noise_m: [0.007, 0]")),
             ErrorCode::INVALID_ARGUMENT);
-  EXPECT_EQ(code(replaced("- radii_m: [0.02000", "- radius_m: [0.02000")), ErrorCode::PARSE_ERROR);
+  EXPECT_EQ(code(replaced("- radii_m: [0.02", "- radius_m: [0.02")), ErrorCode::PARSE_ERROR);
   // Files from before the readings were recorded load; the modeler says they are old.
   const std::string no_readings = replaced(
-      "  noise_readings:\n    - radii_m: [0.02000, 0.05000]\n      noise_m: "
-      "[0.00700, 0.00600]\n",
+      "  noise_readings:\n    - radii_m: [0.02, 0.05]\n      noise_m: "
+      "[0.007, 0.006]\n",
       "");
   EXPECT_TRUE(
       modeling::loadSensorCalibration(dir.write("older.yaml", no_readings)).noise_readings.empty());
   // A gain this low would multiply the width's noise tenfold into the radius.
-  EXPECT_EQ(code(replaced("diameter_gain: [0.40000]", "diameter_gain: [0.10000]")),
+  EXPECT_EQ(code(replaced("diameter_gain: [0.4]", "diameter_gain: [0.1]")),
             ErrorCode::INVALID_ARGUMENT);
   // Files from before the gain was measured: the footprint only adds a margin.
   EXPECT_DOUBLE_EQ(modeling::loadSensorCalibration(
-                       dir.write("old.yaml", replaced("\n    diameter_gain: [0.40000]", "")))
+                       dir.write("old.yaml", replaced("\n    diameter_gain: [0.4]", "")))
                        .silhouette.diameter_gain,
                    1.0);
   EXPECT_THROW(modeling::loadSensorCalibration(dir.file("missing.yaml")), Error);
@@ -191,6 +191,43 @@ TEST(SensorCalibrationFile, RoundTripsAndNamesWhatIsWrong) {
       modeling::loadSensorCalibration(dir.write("other.yaml", replaced("unit 1234", "unit 99")))
           .hash,
       back.hash);
+}
+
+TEST(SensorCalibrationFile, AWrittenFileLoadsBackAsTheSameNumbers) {
+  test::TempDir dir;
+  // Values as a measurement leaves them, not short decimals.
+  const double k = 4.0 / 3.0;
+  modeling::SensorCalibration c;
+  c.name = "measured";
+  c.trunk_footprint.radii = {0.008, 0.0125 + 1e-7 * k, 0.05};
+  c.trunk_footprint.noise = {0.0086925, 0.0121 * k};
+  c.trunk_footprint.bias = {0.0052013 * k, 0.0047, -0.00084 * k, 0.0061, 0.005 * k, 1e-9 * k};
+  c.branch_footprint.radii = {0.002, 0.0065 * k};
+  c.branch_footprint.noise = {0.0086925};
+  c.branch_footprint.bias = {0.008140901744318, 0.0061747499 * k};
+  c.coverage = {0.008, 0.1 * k, 0.002, 0.02 * k, 0.0086925, 0.0121 * k};
+  c.silhouette = {true, 0.0239 * k, 0.0083 * k, 1.21 * k, 3.45, 0.7 * k, 0.4 * k};
+  c.noise_readings = {{{0.0125, 0.05 * k}, {0.00828 * k, 0.00869}}};
+  const auto back = modeling::loadSensorCalibration(
+      dir.write("cal.yaml", modeling::sensorCalibrationToYaml(c, "")));
+  const auto same = [](const modeling::RadiusCalibration& a, const modeling::RadiusCalibration& b) {
+    EXPECT_EQ(a.radii, b.radii);
+    EXPECT_EQ(a.noise, b.noise);
+    EXPECT_EQ(a.bias, b.bias);
+  };
+  same(back.trunk_footprint, c.trunk_footprint);
+  same(back.branch_footprint, c.branch_footprint);
+  EXPECT_EQ(back.coverage.trunk_radius_max_m, c.coverage.trunk_radius_max_m);
+  EXPECT_EQ(back.coverage.branch_radius_max_m, c.coverage.branch_radius_max_m);
+  EXPECT_EQ(back.coverage.noise_max_m, c.coverage.noise_max_m);
+  ASSERT_EQ(back.noise_readings.size(), 1u);
+  EXPECT_EQ(back.noise_readings[0].radii_m, c.noise_readings[0].radii_m);
+  EXPECT_EQ(back.noise_readings[0].noise_m, c.noise_readings[0].noise_m);
+  EXPECT_EQ(back.silhouette.growth_m, c.silhouette.growth_m);
+  EXPECT_EQ(back.silhouette.growth_per_m, c.silhouette.growth_per_m);
+  EXPECT_EQ(back.silhouette.range_min_m, c.silhouette.range_min_m);
+  EXPECT_EQ(back.silhouette.depth_share, c.silhouette.depth_share);
+  EXPECT_EQ(back.silhouette.diameter_gain, c.silhouette.diameter_gain);
 }
 
 // Samples on rods of 4-40 mm seen at 1.2-3.0 m whose widths follow width(diameter, range).
