@@ -116,8 +116,8 @@ std::pair<double, double> range(const YAML::Node& n, const std::string& key,
 }
 
 /// The values as a YAML list, each the shortest decimal that reads back as the same double, so
-/// that a file written and loaded again is the calibration that was measured: where a beam's
-/// table is nearly flat, its inversion turns micrometres of rounding into millimetres.
+/// that a file written and loaded again models trees as the calibration that was measured: a
+/// model can turn micrometres of difference in its tables into millimetres (calibration.md).
 std::string list(const std::vector<double>& v) {
   std::string s = "[";
   char buf[32];
