@@ -16,6 +16,7 @@
 #include "dormant_tree_modeling/io/pose_json.h"
 #include "dormant_tree_modeling/io/tree_json.h"
 #include "dormant_tree_modeling/modeling/noise_bias.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
 #include "dormant_tree_modeling/modeling/tree_modeler.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
 #include "dormant_tree_modeling/registration/view_folder.h"
@@ -676,6 +677,11 @@ RigCalibrationResult calibrateFromRig(const std::vector<RigScan>& scans,
   c.coverage.noise_max_m = rows.back();
   c.trunk_footprint = footprintTable(result.samples, true, rows);
   c.branch_footprint = footprintTable(result.samples, false, rows);
+  const auto branch_table = modeling::addFootprint(branch_noise, c.branch_footprint);
+  for (const double sigma : rows) {
+    result.branch_floor_reach.push_back(
+        {sigma, branch_table.floorAmbiguity(modeling::MIN_BRANCH_RADIUS_M, sigma).radius});
+  }
   const auto silhouette = samplesOnRods(stations, rigs, search, registration::AxisConfig{});
   if (silhouette.size() >= static_cast<std::size_t>(search.min_silhouette_samples)) {
     c.silhouette = fitSilhouette(silhouette, &result.warnings);

@@ -65,6 +65,42 @@ double RadiusCalibration::correct(double apparent, double sigma, double min_radi
   return 0.5 * (lo + hi);
 }
 
+bool RadiusCalibration::resolves(double radius, double sigma, double floor_radius) const {
+  if (!valid())
+    return radius > floor_radius;
+  return radius + biasAt(radius, sigma) > floorAmbiguity(floor_radius, sigma).apparent;
+}
+
+RadiusCalibration::FloorAmbiguity RadiusCalibration::floorAmbiguity(double floor_radius,
+                                                                    double sigma) const {
+  auto apparent = [&](double r) { return r + biasAt(r, sigma); };
+  FloorAmbiguity out{floor_radius, apparent(floor_radius)};
+  if (!valid())
+    return out;
+  // The apparent radius is linear between the table's radii and grows as r beyond them: walk
+  // its pieces with the widest reading so far. A piece ending no wider is read before; a
+  // piece that rises past it is read before up to where it crosses.
+  double from = floor_radius, widest = out.apparent;
+  for (const double to : radii) {
+    if (to <= from)
+      continue;
+    const double a = apparent(from), b = apparent(to);
+    if (b <= widest) {
+      out = {to, widest};
+    } else if (a < widest) {
+      out = {from + (widest - a) / (b - a) * (to - from), widest};
+      widest = b;
+    } else {
+      widest = b;
+    }
+    from = to;
+  }
+  const double last = apparent(from);
+  if (last < widest)
+    out = {from + (widest - last), widest};
+  return out;
+}
+
 std::pair<std::size_t, double> gridPosition(const std::vector<double>& grid, double x) {
   if (grid.size() < 2 || x <= grid.front())
     return {0, 0.0};

@@ -155,20 +155,33 @@ DiameterCorrection describeCalibration(const ModelerConfig& config, const TreeMo
   return d;
 }
 
-/// The branches whose diameter is the floor, not a measurement (empty when none).
-std::string floorWarning(const TreeModel& model, double estimated_sigma) {
-  std::size_t at_floor = 0;
-  for (const auto& b : model.primary_branches)
-    at_floor += !b.measurement.diameter_resolved;
-  if (at_floor == 0)
+/// The branches whose diameter is no measurement (empty when none): at the floor, or read as
+/// thinner branches read too (`sigma` as the tables read the noise).
+std::string floorWarning(const TreeModel& model, const ModelerConfig& config,
+                         double estimated_sigma, double sigma) {
+  std::size_t unresolved = 0, at_floor = 0;
+  for (const auto& b : model.primary_branches) {
+    unresolved += !b.measurement.diameter_resolved;
+    at_floor += b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE;
+  }
+  if (unresolved == 0)
     return {};
-  char text[256];
+  char text[512];
   std::snprintf(text, sizeof(text),
-                "%zu of %zu branch diameters were not measured: at %.1f mm of estimated range "
-                "noise their radius corrected to the %.0f mm floor (diameter_resolved false)",
-                at_floor, model.primary_branches.size(), 1000 * estimated_sigma,
+                "%zu of %zu branch diameters were not measured (diameter_resolved false): at %.1f "
+                "mm of estimated range noise %zu corrected to the %.0f mm floor",
+                unresolved, model.primary_branches.size(), 1000 * estimated_sigma, at_floor,
                 2000 * MIN_BRANCH_RADIUS_M);
-  return text;
+  std::string out = text;
+  if (unresolved > at_floor) {
+    const double reach =
+        config.branch_calibration.floorAmbiguity(MIN_BRANCH_RADIUS_M, sigma).radius;
+    std::snprintf(text, sizeof(text),
+                  ", %zu where the tables read diameters of %.0f to %.1f mm alike",
+                  unresolved - at_floor, 2000 * MIN_BRANCH_RADIUS_M, 2000 * reach);
+    out += text;
+  }
+  return out;
 }
 
 /// Which calibration the diameters went through, where the tree needed it beyond its rig, and
@@ -177,7 +190,7 @@ std::string floorWarning(const TreeModel& model, double estimated_sigma) {
 DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
                                       double estimated_sigma, double sigma) {
   DiameterCorrection d = describeCalibration(config, model, estimated_sigma, sigma);
-  const std::string floor = floorWarning(model, estimated_sigma);
+  const std::string floor = floorWarning(model, config, estimated_sigma, sigma);
   if (!floor.empty())
     d.warnings.push_back(floor);
   return d;
@@ -324,6 +337,19 @@ std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<i
   return out;
 }
 
+/// Whether a branch's radius is a measurement: above the floor, and, where the tables
+/// corrected it, read wider than every radius they cannot tell from the floor (a wide beam
+/// reads thin branches of several radii alike).
+bool diameterResolved(double radius, const TrunkModel& trunk, const ModelerConfig& config) {
+  const RadiusCalibration& table = config.branch_calibration;
+  if (radius <= MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE)
+    return false;
+  if (!config.noise.correct_bias || !config.fit.constrain || config.branches.raw_radius ||
+      !table.valid())
+    return true;
+  return table.resolves(radius, trunk.table_sigma, MIN_BRANCH_RADIUS_M);
+}
+
 /// A branch fit as the model reports it, measured where its axis meets the trunk, which may be
 /// another segment than the one its candidate points came nearest to. The trunk diameter there
 /// is interpolated: a segment's own diameter put 13-18 % of the branches on the wrong segment
@@ -341,7 +367,7 @@ PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
   pb.measurement.trunk_diameter = trunk.diameterAt(s);
   pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
   pb.measurement.prune = pb.measurement.diameter_ratio > config.prune_ratio;
-  pb.measurement.diameter_resolved = f.cylinder.radius > MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE;
+  pb.measurement.diameter_resolved = diameterResolved(f.cylinder.radius, trunk, config);
   return pb;
 }
 

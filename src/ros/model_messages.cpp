@@ -122,7 +122,7 @@ visualization_msgs::MarkerArray toMarkers(const modeling::TreeModel& model,
     array.markers.push_back(label(c, header, "trunk_labels"));
   }
   for (const auto& b : model.primary_branches) {
-    // Red: to prune; green: to keep; grey: its diameter was not measured (at the floor).
+    // Red: to prune; green: to keep; grey: its diameter was not measured (diameter_resolved).
     const bool prune = b.measurement.prune;
     float r = prune ? 0.9f : 0.1f, g = prune ? 0.1f : 0.75f, blue = 0.1f;
     if (!b.measurement.diameter_resolved)

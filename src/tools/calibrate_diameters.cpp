@@ -10,6 +10,7 @@
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/io/point_cloud_io.h"
 #include "dormant_tree_modeling/io/tree_json.h"
+#include "dormant_tree_modeling/modeling/tree_model.h"
 
 namespace po = boost::program_options;
 using namespace dormant_tree_modeling;
@@ -48,6 +49,14 @@ void printSamples(const calibration::RigCalibrationResult& result) {
                 1000 * c.branch_radius_min_m, 1000 * c.branch_radius_max_m, 1000 * c.noise_min_m,
                 1000 * c.noise_max_m);
   std::cerr << line;
+  for (const auto& f : result.branch_floor_reach) {
+    std::snprintf(line, sizeof(line),
+                  "at %.2f mm of noise the tables cannot tell branches of up to %.1f mm in "
+                  "diameter from thinner ones: the modeler reports such readings at its %.1f mm "
+                  "floor, not measured\n",
+                  1000 * f.noise_m, 2000 * f.radius_m, 2000 * modeling::MIN_BRANCH_RADIUS_M);
+    std::cerr << line;
+  }
   const auto& s = result.calibration.silhouette;
   if (s.measured) {
     std::snprintf(line, sizeof(line),

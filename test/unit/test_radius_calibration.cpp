@@ -48,6 +48,39 @@ TEST(RadiusCalibration, CorrectInvertsTheTable) {
   EXPECT_DOUBLE_EQ(RadiusCalibration{}.correct(0.02, 0.004, 0.001), 0.02);  // empty: identity
 }
 
+TEST(RadiusCalibration, AReadingThatThinnerRadiiGiveTooIsNoMeasurement) {
+  // A wide beam's table: the widening falls faster than the radius grows from 4 to 6 mm, so
+  // 2, 4, 6 and 12 mm read 12, 13, 12 and 14 mm, and 12.5 mm fits 3, 5 and 7.5 mm alike;
+  // only radii past 9 mm read wider than 13 mm.
+  RadiusCalibration c;
+  c.radii = {0.002, 0.004, 0.006, 0.012};
+  c.noise = {0.005};
+  c.bias = {0.010, 0.009, 0.006, 0.002};
+  const auto floor = c.floorAmbiguity(0.002, 0.005);
+  EXPECT_NEAR(floor.radius, 0.009, 1e-12);
+  EXPECT_NEAR(floor.apparent, 0.013, 1e-12);
+  // A reading no wider than the floor's is the floor; one that thinner radii read too is one
+  // of its radii, and not resolved; past the ambiguity the one radius, resolved.
+  EXPECT_DOUBLE_EQ(c.correct(0.0119, 0.005, 0.002), 0.002);
+  EXPECT_FALSE(c.resolves(0.002, 0.005, 0.002));
+  for (const double apparent : {0.0125, 0.013}) {
+    const double r = c.correct(apparent, 0.005, 0.002);
+    EXPECT_NEAR(r + c.biasAt(r, 0.005), apparent, 1e-9);
+    EXPECT_FALSE(c.resolves(r, 0.005, 0.002)) << apparent;
+  }
+  EXPECT_NEAR(c.correct(0.0135, 0.005, 0.002), 0.0105, 1e-9);
+  EXPECT_TRUE(c.resolves(0.0105, 0.005, 0.002));
+  // Past the table the widening is held: a table ending low is ambiguous beyond its end.
+  c.bias.back() = -0.0005;  // 12 mm reads 11.5 mm, 13.5 mm reads 13 mm
+  EXPECT_NEAR(c.floorAmbiguity(0.002, 0.005).radius, 0.0135, 1e-12);
+  // Where the apparent radius grows everywhere the floor is ambiguous with itself alone.
+  const auto plain = table().floorAmbiguity(0.002, 0.004);
+  EXPECT_DOUBLE_EQ(plain.radius, 0.002);
+  EXPECT_TRUE(table().resolves(0.0021, 0.004, 0.002));
+  EXPECT_NEAR(plain.apparent, 0.002 + table().biasAt(0.002, 0.004), 1e-12);
+  EXPECT_DOUBLE_EQ(RadiusCalibration{}.floorAmbiguity(0.002, 0.004).radius, 0.002);
+}
+
 TEST(RadiusCalibration, ConfigRejectsInconsistentTables) {
   ModelerConfig config;
   config.trunk_calibration = table();

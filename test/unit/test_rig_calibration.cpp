@@ -405,6 +405,12 @@ TEST_F(RigCalibration, EveryPartIsFoundAndTheFootprintShrinksWithTheRadius) {
   EXPECT_LT(standard, 0.009);
   EXPECT_DOUBLE_EQ(c.coverage.noise_min_m, standard);
   EXPECT_EQ(c.trunk_footprint.noise, std::vector<double>{standard});
+  // Our beam widens the thinnest rods more than it widens thicker ones by their extra radius:
+  // the tables cannot tell branches a little thicker than the floor from it.
+  ASSERT_EQ(result.branch_floor_reach.size(), 1u);
+  EXPECT_DOUBLE_EQ(result.branch_floor_reach[0].noise_m, standard);
+  EXPECT_GT(result.branch_floor_reach[0].radius_m, 0.0025);
+  EXPECT_LT(result.branch_floor_reach[0].radius_m, c.coverage.branch_radius_max_m);
 }
 
 TEST_F(RigCalibration, TheRigsViewsGiveTheSilhouetteGrowthOfTheBeam) {

@@ -45,11 +45,19 @@ struct RigSample {
   double footprint() const { return apparent - radius - noise_part; }
 };
 
+/// @brief Up to which true radius a branch cannot be told from the modeler's floor, at one
+/// noise row of a calibration (RadiusCalibration::floorAmbiguity of its branch table).
+struct FloorReach {
+  double noise_m = 0.0;   ///< the row's noise reading
+  double radius_m = 0.0;  ///< the largest true radius that some thinner one reads alike
+};
+
 /// @brief A calibration and how it was made.
 struct RigCalibrationResult {
   modeling::SensorCalibration calibration;
   std::vector<RigSample> samples;
-  std::vector<std::string> warnings;  ///< rods or sections not found, narrow coverage
+  std::vector<FloorReach> branch_floor_reach;  ///< one per noise row, ascending noise
+  std::vector<std::string> warnings;           ///< rods or sections not found, narrow coverage
 };
 
 /// @brief How the rig's parts are searched for around the axes RIG.json gives.

@@ -51,8 +51,9 @@ struct TreeScore {
   int pb = 0;   ///< true primary branches
   int ipb = 0;  ///< detections, ignored ones excluded
   int tp = 0, fp = 0, fn = 0, ignored = 0;
-  /// TP pairs whose detection's diameter was not measured (diameter_resolved false: corrected
-  /// to the floor); their errors count in the diameter columns as reported.
+  /// TP pairs whose detection's diameter was not measured (diameter_resolved false: at the
+  /// floor, or a reading thinner radii give too); their errors count in the diameter columns
+  /// as reported.
   int unresolved = 0;
   double fp_rate = 0.0, fn_rate = 0.0, f1 = 0.0;
   double branch_mae = 0.0, branch_rmse = 0.0, branch_bias = 0.0;  ///< m, over TP pairs

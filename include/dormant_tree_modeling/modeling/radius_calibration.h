@@ -38,9 +38,34 @@ struct RadiusCalibration {
   double biasAt(double radius, double sigma) const;
 
   /// @brief The true radius whose apparent radius is `apparent` (inversion of
-  /// apparent = r + bias(r, sigma)); `apparent` itself when the table is empty.
+  /// apparent = r + bias(r, sigma)); `apparent` itself when the table is empty. Where several
+  /// radii read alike (floorAmbiguity) it is one of them: resolves() says so.
   /// @param min_radius floor of the result (m)
   double correct(double apparent, double sigma, double min_radius) const;
+
+  /// @brief Where the table cannot tell a radius from the floor at `sigma`: true radii up to
+  /// `radius` each read (apparent = r + bias) no wider than some smaller radius down to the
+  /// floor does, so apparent radii up to `apparent` have no single true radius; correct()
+  /// takes them to the floor. Where the apparent radius grows everywhere above the floor
+  /// that is the floor and its own apparent radius.
+  struct FloorAmbiguity {
+    double radius = 0.0;    ///< the largest true radius read as some smaller one (m)
+    double apparent = 0.0;  ///< the widest apparent radius of the radii up to it (m)
+  };
+
+  /// @brief Whether `radius`, as correct() returned it, is a measurement: its apparent radius
+  /// is wider than any the radii up to the floor's ambiguity read (false at the floor, and
+  /// for a reading several radii give).
+  /// @param radius a corrected radius (m)
+  /// @param sigma the noise it was corrected at (m)
+  /// @param floor_radius the smallest radius correct() returns (m)
+  bool resolves(double radius, double sigma, double floor_radius) const;
+
+  /// @brief The ambiguity at the floor (FloorAmbiguity), exact on the table's piecewise-linear
+  /// apparent radius.
+  /// @param floor_radius the smallest radius correct() returns (m)
+  /// @param sigma the estimated range noise (m)
+  FloorAmbiguity floorAmbiguity(double floor_radius, double sigma) const;
 };
 
 }  // namespace modeling
