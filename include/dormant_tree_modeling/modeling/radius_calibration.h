@@ -45,9 +45,9 @@ struct RadiusCalibration {
 
   /// @brief Where the table cannot tell a radius from the floor at `sigma`: true radii up to
   /// `radius` each read (apparent = r + bias) no wider than some smaller radius down to the
-  /// floor does, so apparent radii up to `apparent` have no single true radius; correct()
-  /// takes them to the floor. Where the apparent radius grows everywhere above the floor
-  /// that is the floor and its own apparent radius.
+  /// floor does, so apparent radii up to `apparent` have no single true radius (resolves() is
+  /// false for them). Where the apparent radius grows everywhere above the floor that is the
+  /// floor and its own apparent radius.
   struct FloorAmbiguity {
     double radius = 0.0;    ///< the largest true radius read as some smaller one (m)
     double apparent = 0.0;  ///< the widest apparent radius of the radii up to it (m)
