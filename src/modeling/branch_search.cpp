@@ -490,7 +490,7 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   if (!cyl)
     return cyl;
   *wood_radius = cyl->radius;
-  if (calibrated && !config.branches.raw_radius) {
+  if (config.branchTableCorrects()) {
     const auto& table = config.branch_calibration;
     *wood_radius = table.correct(*wood_radius, bands.table_sigma, MIN_BRANCH_RADIUS_M);
     spread = table.correct(spread, bands.table_sigma, MIN_BRANCH_RADIUS_M);

@@ -253,6 +253,10 @@ const ConfigTable<ModelerConfig>& modelerConfigTable() {
   return table;
 }
 
+bool ModelerConfig::branchTableCorrects() const {
+  return fit.constrain && noise.correct_bias && !branches.raw_radius && branch_calibration.valid();
+}
+
 ModelerConfig ModelerConfig::paper() {
   ModelerConfig c;
   c.noise.derive_parameters = false;

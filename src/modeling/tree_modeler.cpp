@@ -341,13 +341,10 @@ std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<i
 /// corrected it, read wider than every radius they cannot tell from the floor (a wide beam
 /// reads thin branches of several radii alike).
 bool diameterResolved(double radius, const TrunkModel& trunk, const ModelerConfig& config) {
-  const RadiusCalibration& table = config.branch_calibration;
   if (radius <= MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE)
     return false;
-  if (!config.noise.correct_bias || !config.fit.constrain || config.branches.raw_radius ||
-      !table.valid())
-    return true;
-  return table.resolves(radius, trunk.table_sigma, MIN_BRANCH_RADIUS_M);
+  return !config.branchTableCorrects() ||
+         config.branch_calibration.resolves(radius, trunk.table_sigma, MIN_BRANCH_RADIUS_M);
 }
 
 /// A branch fit as the model reports it, measured where its axis meets the trunk, which may be

@@ -52,8 +52,8 @@ void printSamples(const calibration::RigCalibrationResult& result) {
   for (const auto& f : result.branch_floor_reach) {
     std::snprintf(line, sizeof(line),
                   "at %.2f mm of noise the tables cannot tell branches of up to %.1f mm in "
-                  "diameter from thinner ones: the modeler reports such readings at its %.1f mm "
-                  "floor, not measured\n",
+                  "diameter from thinner ones (down to the %.1f mm floor): the modeler reports "
+                  "such readings as not measured (diameter_resolved false)\n",
                   1000 * f.noise_m, 2000 * f.radius_m, 2000 * modeling::MIN_BRANCH_RADIUS_M);
     std::cerr << line;
   }

@@ -163,6 +163,11 @@ struct ModelerConfig {
   /// empty: the moment less beam_spread_m and noise in quadrature instead.
   RadiusCalibration branch_calibration;
 
+  /// @brief Whether the branch step's radii go through branch_calibration: its own fits
+  /// (fit.constrain), corrected (noise.correct_bias), not raw (branches.raw_radius), with a
+  /// usable table.
+  bool branchTableCorrects() const;
+
   /// @brief The paper's method alone: every switch past the paper off.
   static ModelerConfig paper();
 
