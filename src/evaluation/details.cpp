@@ -49,13 +49,17 @@ std::string formatDetails(const TreeScore& score, const modeling::TreeModel& mod
   line(buf);
   for (const auto& m : score.matches) {
     const auto& c = model.primary_branches[m.detection].cylinder;
-    std::snprintf(
-        buf, sizeof(buf),
-        "  TP  det %3d z %5.2f m  d %5.1f mm | truth %3d d %5.1f mm  err %+5.1f mm  "
-        "e %4.1f mm%s\n",
-        c.id, c.center.z(), 1000 * m.detected_diameter, truth.primary_branches[m.truth].id,
-        1000 * m.true_diameter, 1000 * (m.detected_diameter - m.true_diameter), 1000 * m.e,
-        model.primary_branches[m.detection].measurement.diameter_resolved ? "" : "  not measured");
+    const auto& measured = model.primary_branches[m.detection].measurement;
+    char range[64] = "";
+    if (!measured.diameter_resolved)
+      std::snprintf(range, sizeof(range), "  not measured: %.1f to %.1f mm",
+                    1000 * measured.diameter_min, 1000 * measured.diameter_max);
+    std::snprintf(buf, sizeof(buf),
+                  "  TP  det %3d z %5.2f m  d %5.1f mm | truth %3d d %5.1f mm  err %+5.1f mm  "
+                  "e %4.1f mm%s\n",
+                  c.id, c.center.z(), 1000 * m.detected_diameter,
+                  truth.primary_branches[m.truth].id, 1000 * m.true_diameter,
+                  1000 * (m.detected_diameter - m.true_diameter), 1000 * m.e, range);
     line(buf);
   }
   for (const int d : score.false_positives) {

@@ -197,7 +197,12 @@ void scoreDetections(const modeling::TreeModel& model, const GroundTruth& truth,
       s.branch_mae += std::abs(err);
       s.branch_bias += err;
       sq += err * err;
-      s.unresolved += !model.primary_branches[d].measurement.diameter_resolved;
+      const auto& measured = model.primary_branches[d].measurement;
+      if (!measured.diameter_resolved) {
+        ++s.unresolved;
+        s.unresolved_in_range +=
+            m.true_diameter >= measured.diameter_min && m.true_diameter <= measured.diameter_max;
+      }
       s.matches.push_back(m);
       continue;
     }
@@ -315,6 +320,7 @@ TreeScore meanScore(const std::vector<TreeScore>& scores) {
     m.fp += s.fp;
     m.fn += s.fn;
     m.unresolved += s.unresolved;
+    m.unresolved_in_range += s.unresolved_in_range;
     m.fp_rate += s.fp_rate / n;
     m.fn_rate += s.fn_rate / n;
     m.f1 += s.f1 / n;

@@ -25,6 +25,7 @@ nlohmann::json toJson(const TreeScore& s) {
           {"fn", s.fn},
           {"ignored", s.ignored},
           {"unresolved_diameters", s.unresolved},
+          {"unresolved_in_range", s.unresolved_in_range},
           {"fp_rate", s.fp_rate},
           {"fn_rate", s.fn_rate},
           {"f1", s.f1},

@@ -25,15 +25,16 @@ std::string cylindersToCsv(const modeling::TreeModel& model, const Eigen::Vector
       "role,id,parent_id,center_x,center_y,center_z,axis_x,axis_y,axis_z,diameter_m,length_m,num_"
       "points,"
       "inlier_ratio,attachment_height_m,angle_to_trunk_deg,trunk_diameter_m,diameter_ratio,prune,"
-      "diameter_resolved\n";
+      "diameter_resolved,diameter_min_m,diameter_max_m\n";
   for (const auto& c : model.trunk)
-    out += common("trunk", c, -1, offset) + ",,,,,,\n";
+    out += common("trunk", c, -1, offset) + ",,,,,,,,\n";
   for (const auto& b : model.primary_branches) {
-    char buf[160];
-    std::snprintf(buf, sizeof(buf), ",%.4f,%.2f,%.5f,%.3f,%d,%d\n", b.measurement.attachment_height,
-                  b.measurement.angle_to_trunk * 180.0 / M_PI, b.measurement.trunk_diameter,
-                  b.measurement.diameter_ratio, b.measurement.prune ? 1 : 0,
-                  b.measurement.diameter_resolved ? 1 : 0);
+    char buf[200];
+    std::snprintf(buf, sizeof(buf), ",%.4f,%.2f,%.5f,%.3f,%d,%d,%.5f,%.5f\n",
+                  b.measurement.attachment_height, b.measurement.angle_to_trunk * 180.0 / M_PI,
+                  b.measurement.trunk_diameter, b.measurement.diameter_ratio,
+                  b.measurement.prune ? 1 : 0, b.measurement.diameter_resolved ? 1 : 0,
+                  b.measurement.diameter_min, b.measurement.diameter_max);
     out += common("primary_branch", b.cylinder, b.trunk_segment, offset) + buf;
   }
   return out;

@@ -233,6 +233,8 @@ std::string modelToJson(const modeling::TreeModel& model, const Eigen::Vector3d&
     j["diameter_ratio"] = b.measurement.diameter_ratio;
     j["prune"] = b.measurement.prune;
     j["diameter_resolved"] = b.measurement.diameter_resolved;
+    j["diameter_min"] = b.measurement.diameter_min;
+    j["diameter_max"] = b.measurement.diameter_max;
     branches.push_back(j);
   }
   json doc{{"format", MODEL_FORMAT},
@@ -303,6 +305,12 @@ modeling::TreeModel modelFromDocument(const std::string& text) {
       b.measurement.prune = j["prune"].get<bool>();
     if (j.contains("diameter_resolved") && j["diameter_resolved"].is_boolean())
       b.measurement.diameter_resolved = j["diameter_resolved"].get<bool>();
+    // Models written before the range was reported: the diameter is all they say.
+    b.measurement.diameter_min = b.measurement.diameter_max = b.cylinder.diameter;
+    if (j.contains("diameter_min") && j["diameter_min"].is_number())
+      b.measurement.diameter_min = j["diameter_min"].get<double>();
+    if (j.contains("diameter_max") && j["diameter_max"].is_number())
+      b.measurement.diameter_max = j["diameter_max"].get<double>();
     model.primary_branches.push_back(b);
   }
   model.correction = correctionFromJson(doc);

@@ -347,6 +347,20 @@ bool diameterResolved(double radius, const TrunkModel& trunk, const ModelerConfi
          config.branch_calibration.resolves(radius, trunk.table_sigma, MIN_BRANCH_RADIUS_M);
 }
 
+/// The narrowest and widest diameters a branch may have (m): its diameter where it was
+/// measured; otherwise the floor up to the widest radius the tables cannot tell from it (all
+/// apparent radii up to the floor's ambiguity read alike within a fraction of a millimetre).
+std::pair<double, double> diameterRange(double radius, bool resolved, const TrunkModel& trunk,
+                                        const ModelerConfig& config) {
+  if (resolved)
+    return {2 * radius, 2 * radius};
+  const double reach =
+      config.branchTableCorrects()
+          ? config.branch_calibration.floorAmbiguity(MIN_BRANCH_RADIUS_M, trunk.table_sigma).radius
+          : MIN_BRANCH_RADIUS_M;
+  return {2 * MIN_BRANCH_RADIUS_M, 2 * std::max(reach, radius)};
+}
+
 /// A branch fit as the model reports it, measured where its axis meets the trunk, which may be
 /// another segment than the one its candidate points came nearest to. The trunk diameter there
 /// is interpolated: a segment's own diameter put 13-18 % of the branches on the wrong segment
@@ -365,6 +379,10 @@ PrimaryBranch primaryBranch(const BranchFit& f, const TrunkModel& trunk, int id,
   pb.measurement.diameter_ratio = pb.cylinder.diameter / pb.measurement.trunk_diameter;
   pb.measurement.prune = pb.measurement.diameter_ratio > config.prune_ratio;
   pb.measurement.diameter_resolved = diameterResolved(f.cylinder.radius, trunk, config);
+  const auto range =
+      diameterRange(f.cylinder.radius, pb.measurement.diameter_resolved, trunk, config);
+  pb.measurement.diameter_min = range.first;
+  pb.measurement.diameter_max = range.second;
   return pb;
 }
 

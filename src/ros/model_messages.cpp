@@ -62,7 +62,7 @@ visualization_msgs::Marker cylinderMarker(const modeling::CylinderModel& c,
 }
 
 visualization_msgs::Marker label(const modeling::CylinderModel& c, const std_msgs::Header& header,
-                                 const std::string& ns) {
+                                 const std::string& ns, const std::string& text) {
   visualization_msgs::Marker m =
       newMarker(header, ns, c.id, visualization_msgs::Marker::TEXT_VIEW_FACING);
   const Eigen::Vector3d p = c.center + 0.5 * c.length * c.axis;
@@ -73,10 +73,19 @@ visualization_msgs::Marker label(const modeling::CylinderModel& c, const std_msg
   m.scale.z = 0.04;
   m.color.r = m.color.g = m.color.b = 1.0f;
   m.color.a = 1.0f;
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.1f cm", 100.0 * c.diameter);
   m.text = text;
   return m;
+}
+
+/// A diameter in cm; a branch whose diameter was not measured shows the range it may have.
+std::string diameterText(double diameter, const modeling::BranchMeasurement* branch = nullptr) {
+  char text[48];
+  if (branch && !branch->diameter_resolved)
+    std::snprintf(text, sizeof(text), "%.1f-%.1f cm", 100.0 * branch->diameter_min,
+                  100.0 * branch->diameter_max);
+  else
+    std::snprintf(text, sizeof(text), "%.1f cm", 100.0 * diameter);
+  return text;
 }
 
 }  // namespace
@@ -99,6 +108,8 @@ dormant_tree_modeling::TreeModel toMsg(const modeling::TreeModel& model,
     m.diameter_ratio = b.measurement.diameter_ratio;
     m.prune = b.measurement.prune;
     m.diameter_resolved = b.measurement.diameter_resolved;
+    m.diameter_min = b.measurement.diameter_min;
+    m.diameter_max = b.measurement.diameter_max;
     msg.measurements.push_back(m);
   }
   msg.input_points = static_cast<std::uint32_t>(model.input_points);
@@ -119,7 +130,7 @@ visualization_msgs::MarkerArray toMarkers(const modeling::TreeModel& model,
   array.markers.push_back(clear);
   for (const auto& c : model.trunk) {
     array.markers.push_back(cylinderMarker(c, header, "trunk", 0.55f, 0.32f, 0.08f));
-    array.markers.push_back(label(c, header, "trunk_labels"));
+    array.markers.push_back(label(c, header, "trunk_labels", diameterText(c.diameter)));
   }
   for (const auto& b : model.primary_branches) {
     // Red: to prune; green: to keep; grey: its diameter was not measured (diameter_resolved).
@@ -128,7 +139,8 @@ visualization_msgs::MarkerArray toMarkers(const modeling::TreeModel& model,
     if (!b.measurement.diameter_resolved)
       r = g = blue = 0.6f;
     array.markers.push_back(cylinderMarker(b.cylinder, header, "primary_branches", r, g, blue));
-    array.markers.push_back(label(b.cylinder, header, "primary_branch_labels"));
+    array.markers.push_back(label(b.cylinder, header, "primary_branch_labels",
+                                  diameterText(b.cylinder.diameter, &b.measurement)));
   }
   return array;
 }

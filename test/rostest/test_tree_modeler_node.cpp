@@ -40,15 +40,22 @@ TEST(TreeModelerNode, PublishesModelMarkersAndSegments) {
   EXPECT_EQ(markers->markers.size(),
             1 + 2 * (model->trunk.size() + model->primary_branches.size()));
   // A branch whose radius was corrected to its floor says so (so may one above it whose
-  // reading thinner branches give too), and its cylinder is grey.
+  // reading thinner branches give too), with the range of diameters it may have; its cylinder
+  // is grey and its label gives that range.
   for (std::size_t i = 0; i < model->measurements.size(); ++i) {
     const auto& m = model->measurements[i];
-    if (m.diameter <= 0.004 + 1e-9)
+    if (m.diameter <= 0.004 + 1e-9) {
       EXPECT_FALSE(m.diameter_resolved) << "branch " << i;
+    }
+    EXPECT_LE(m.diameter_min, m.diameter + 1e-12) << "branch " << i;
+    EXPECT_GE(m.diameter_max, m.diameter - 1e-12) << "branch " << i;
+    EXPECT_DOUBLE_EQ(m.diameter_resolved ? m.diameter : 0.004, m.diameter_min) << "branch " << i;
     const std::size_t marker = 1 + 2 * (model->trunk.size() + i);
-    if (marker < markers->markers.size()) {
+    if (marker + 1 < markers->markers.size()) {
       const auto& color = markers->markers[marker].color;
       EXPECT_EQ(!m.diameter_resolved, color.r == color.g && color.g == color.b) << "branch " << i;
+      const std::string& text = markers->markers[marker + 1].text;
+      EXPECT_EQ(!m.diameter_resolved, text.find('-') != std::string::npos) << text;
     }
   }
   const auto segments =

@@ -85,19 +85,27 @@ TEST(Evaluate, CountsTheMatchedBranchesWhoseDiameterWasNotMeasured) {
     d.cylinder.length = 0.3;
     d.cylinder.diameter = k == 0 ? 0.011 : 0.004;
     d.measurement.diameter_resolved = k == 0;
+    d.measurement.diameter_min = k == 0 ? 0.011 : 0.004;
+    d.measurement.diameter_max = k == 0 ? 0.011 : 0.0095;
     model.primary_branches.push_back(d);
   }
   const TreeScore s = evaluate(model, truth);
   EXPECT_EQ(s.tp, 2);
   EXPECT_EQ(s.unresolved, 1);
+  EXPECT_EQ(s.unresolved_in_range, 0);  // 12 mm is wider than the 9.5 mm it may have
   EXPECT_NEAR(s.branch_mae, 0.5 * (0.001 + 0.008), 1e-12);
   const std::string details = formatDetails(s, model, truth);
-  EXPECT_NE(details.find("not measured"), std::string::npos);
+  EXPECT_NE(details.find("not measured: 4.0 to 9.5 mm"), std::string::npos) << details;
   EXPECT_EQ(details.find("not measured"), details.rfind("not measured"));
   EXPECT_NE(details.find("d   4.0 mm | truth  11 d  12.0 mm  err  -8.0 mm  e"), std::string::npos)
       << details;
   EXPECT_NE(scoresToJson({s}).find("\"unresolved_diameters\": 1"), std::string::npos);
   EXPECT_EQ(meanScore({s, s}).unresolved, 2);
+  model.primary_branches[1].measurement.diameter_max = 0.012;
+  const TreeScore within = evaluate(model, truth);
+  EXPECT_EQ(within.unresolved_in_range, 1);
+  EXPECT_NE(scoresToJson({within}).find("\"unresolved_in_range\": 1"), std::string::npos);
+  EXPECT_EQ(meanScore({s, within}).unresolved_in_range, 1);
 }
 
 TEST(Assign, FindsTheMostMatchesAtTheLeastCostLikeBruteForce) {

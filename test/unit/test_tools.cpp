@@ -163,6 +163,9 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
   b.trunk_segment = 0;
   b.measurement.angle_to_trunk = M_PI / 2;
   b.measurement.diameter_ratio = 0.4;
+  b.measurement.diameter_resolved = false;
+  b.measurement.diameter_min = 0.004;
+  b.measurement.diameter_max = 0.0215;
   m.primary_branches.push_back(b);
   const std::string csv = io::cylindersToCsv(m, Eigen::Vector3d(100, 0, 0));
   std::istringstream lines(csv);
@@ -174,7 +177,9 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
             std::count(trunk.begin(), trunk.end(), ','));
   EXPECT_EQ(trunk.rfind("trunk,0,-1,100.000000", 0), 0u) << trunk;
   EXPECT_NE(branch.find(",90.00,"), std::string::npos) << branch;
-  EXPECT_NE(branch.find(",0.400,0,1"), std::string::npos) << branch;
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','),
+            std::count(branch.begin(), branch.end(), ','));
+  EXPECT_NE(branch.find(",0.400,0,0,0.00400,0.02150"), std::string::npos) << branch;
 }
 
 TEST(RenderModelTool, FarPointsAreSkippedAndAModelThatIsNoTreeIsRefused) {

@@ -39,6 +39,8 @@ modeling::TreeModel sampleModel() {
   b.measurement.diameter_ratio = 0.35;
   b.measurement.prune = false;
   b.measurement.diameter_resolved = false;
+  b.measurement.diameter_min = 0.004;
+  b.measurement.diameter_max = 0.0215;
   m.primary_branches.push_back(b);
   return m;
 }
@@ -76,6 +78,8 @@ TEST(ModelJson, RoundTrip) {
   EXPECT_DOUBLE_EQ(b.measurement.diameter_ratio, 0.35);
   EXPECT_FALSE(b.measurement.prune);
   EXPECT_FALSE(b.measurement.diameter_resolved);
+  EXPECT_DOUBLE_EQ(b.measurement.diameter_min, 0.004);
+  EXPECT_DOUBLE_EQ(b.measurement.diameter_max, 0.0215);
 }
 
 TEST(ModelJson, WritesTheDocumentedKeysAndOffset) {
@@ -98,6 +102,9 @@ TEST(ModelJson, ParsesAMinimalForeignDocumentAndNormalisesAxes) {
   ASSERT_EQ(m.trunk.size(), 1u);
   ASSERT_EQ(m.primary_branches.size(), 1u);
   EXPECT_TRUE(m.primary_branches[0].measurement.diameter_resolved);
+  // Without a range the diameter is all the document says.
+  EXPECT_DOUBLE_EQ(m.primary_branches[0].measurement.diameter_min, 0.01);
+  EXPECT_DOUBLE_EQ(m.primary_branches[0].measurement.diameter_max, 0.01);
   EXPECT_DOUBLE_EQ(m.trunk[0].axis.z(), 1.0);
   EXPECT_EQ(m.trunk[0].num_points, 0u);
 }

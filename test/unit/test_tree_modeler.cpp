@@ -100,8 +100,19 @@ Unmeasured unmeasuredBranches(const TreeModel& model) {
   Unmeasured n;
   for (const auto& b : model.primary_branches) {
     const bool floor = b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M + 1e-9;
-    if (floor)
+    if (floor) {
       EXPECT_FALSE(b.measurement.diameter_resolved) << "branch " << b.cylinder.id;
+    }
+    // A measured diameter is its own range; one not measured spans the floor up to the widest
+    // diameter the tables cannot tell from it, which holds the one reported.
+    const auto& m = b.measurement;
+    EXPECT_LE(m.diameter_min, b.cylinder.diameter + 1e-12) << "branch " << b.cylinder.id;
+    EXPECT_GE(m.diameter_max, b.cylinder.diameter - 1e-12) << "branch " << b.cylinder.id;
+    if (m.diameter_resolved) {
+      EXPECT_NEAR(m.diameter_max - m.diameter_min, 0.0, 1e-12) << "branch " << b.cylinder.id;
+    } else {
+      EXPECT_DOUBLE_EQ(m.diameter_min, 2 * MIN_BRANCH_RADIUS_M) << "branch " << b.cylinder.id;
+    }
     n.total += !b.measurement.diameter_resolved;
     n.at_floor += floor;
   }
@@ -189,11 +200,15 @@ TEST(TreeModeler, ABranchCorrectedToTheFloorIsNotAMeasurement) {
   EXPECT_GT(told.at_floor, own.at_floor);
   EXPECT_GT(own.total, own.at_floor);
   const double sigma = own_model.correction.table_noise_sigma;
+  const auto& table = own_modeler.config().branch_calibration;
+  const double reach = table.floorAmbiguity(MIN_BRANCH_RADIUS_M, sigma).radius;
   for (const auto& b : own_model.primary_branches) {
     const double r = 0.5 * b.cylinder.diameter;
-    EXPECT_EQ(b.measurement.diameter_resolved,
-              own_modeler.config().branch_calibration.resolves(r, sigma, MIN_BRANCH_RADIUS_M))
+    EXPECT_EQ(b.measurement.diameter_resolved, table.resolves(r, sigma, MIN_BRANCH_RADIUS_M))
         << "branch " << b.cylinder.id;
+    if (!b.measurement.diameter_resolved) {
+      EXPECT_NEAR(b.measurement.diameter_max, 2 * reach, 1e-12) << "branch " << b.cylinder.id;
+    }
   }
 }
 

@@ -55,6 +55,9 @@ struct TreeScore {
   /// floor, or a reading thinner radii give too); their errors count in the diameter columns
   /// as reported.
   int unresolved = 0;
+  /// Of those, the ones whose true diameter lies in the range the model gave
+  /// (diameter_min..diameter_max).
+  int unresolved_in_range = 0;
   double fp_rate = 0.0, fn_rate = 0.0, f1 = 0.0;
   double branch_mae = 0.0, branch_rmse = 0.0, branch_bias = 0.0;  ///< m, over TP pairs
   double trunk_mae = 0.0;                                         ///< m, length-weighted

@@ -14,7 +14,7 @@ constexpr const char* TRUTH_FORMAT = "dormant_tree_truth/1";
 
 /// @brief Serialise a model as the model.json of docs/evaluation.md (extra keys: inlier_ratio,
 /// attachment_height, angle_to_trunk_deg, trunk_diameter, diameter_ratio, prune,
-/// diameter_resolved, runtime_s).
+/// diameter_resolved, diameter_min, diameter_max, runtime_s).
 /// @param model the model
 /// @param offset added to every centre (survey coordinates of the input cloud)
 std::string modelToJson(const modeling::TreeModel& model,

@@ -35,6 +35,13 @@ struct BranchMeasurement {
   /// corrected for is as wide as the branch, so its diameter was not measured and the diameter,
   /// ratio and prune flag carry no information about it.
   bool diameter_resolved = true;
+  /// m, the narrowest and widest diameters the branch may have: both its diameter where it was
+  /// measured; where not, the floor (2 MIN_BRANCH_RADIUS_M) and the widest diameter the branch
+  /// table cannot tell from it (RadiusCalibration::floorAmbiguity at the tree's noise). Where
+  /// diameter_max / trunk_diameter is at most the prune ratio, the branch is to be kept
+  /// whichever diameter it has.
+  double diameter_min = 0.0;
+  double diameter_max = 0.0;
 };
 
 /// @brief A primary branch: its cylinder, the trunk cylinder it leaves, and its measurements.
