@@ -31,9 +31,10 @@ struct BranchMeasurement {
   double trunk_diameter = 0.0;     ///< m, trunk diameter at the attachment
   double diameter_ratio = 0.0;     ///< branch diameter / trunk_diameter
   bool prune = false;              ///< diameter_ratio above the configured limit
-  /// False when the radius was taken to its floor (MIN_BRANCH_RADIUS_M): the noise the modeler
-  /// corrected for is as wide as the branch, so its diameter was not measured and the diameter,
-  /// ratio and prune flag carry no information about it.
+  /// False when the radius was taken to its floor (MIN_BRANCH_RADIUS_M), where the noise the
+  /// modeler corrected for is as wide as the branch, or when its reading is one that thinner
+  /// branches give too (RadiusCalibration::resolves): its diameter was not measured and the
+  /// diameter, ratio and prune flag carry no information about it.
   bool diameter_resolved = true;
   /// m, the narrowest and widest diameters the branch may have: both its diameter where it was
   /// measured; where not, the floor (2 MIN_BRANCH_RADIUS_M) and the widest diameter the branch
