@@ -9,6 +9,7 @@
 
 #include <filesystem>
 
+#include "dormant_tree_modeling/ros/model_messages.h"
 #include "synthetic_tree.h"
 
 namespace {
@@ -72,6 +73,46 @@ TEST(TreeModelerNode, ServiceRemodelsTheLastCloud) {
   EXPECT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_NE(srv.response.message.find("trunk cylinders"), std::string::npos)
       << srv.response.message;
+}
+
+TEST(TreeModelerNode, ABranchNotMeasuredIsGreyAndLabelledWithTheDiametersItMayHave) {
+  // The synthetic tree above has every diameter measured: one trunk cylinder, one branch
+  // measured at 21 mm and one not measured (4 to 9.1 mm).
+  modeling::TreeModel model;
+  modeling::CylinderModel trunk;
+  trunk.diameter = 0.04;
+  trunk.length = 1.0;
+  model.trunk.push_back(trunk);
+  for (int k = 0; k < 2; ++k) {
+    modeling::PrimaryBranch b;
+    b.cylinder.id = 1 + k;
+    b.cylinder.axis = Eigen::Vector3d::UnitX();
+    b.cylinder.length = 0.3;
+    b.cylinder.diameter = k == 0 ? 0.021 : 0.006;
+    b.trunk_segment = 0;
+    b.measurement.diameter_resolved = k == 0;
+    b.measurement.diameter_min = k == 0 ? 0.021 : 0.004;
+    b.measurement.diameter_max = k == 0 ? 0.021 : 0.0091;
+    model.primary_branches.push_back(b);
+  }
+  std_msgs::Header header;
+  header.frame_id = "tree";
+  const auto msg = ros_layer::toMsg(model, header);
+  ASSERT_EQ(msg.measurements.size(), 2u);
+  EXPECT_DOUBLE_EQ(msg.measurements[0].diameter_min, 0.021);
+  EXPECT_DOUBLE_EQ(msg.measurements[0].diameter_max, 0.021);
+  EXPECT_FALSE(msg.measurements[1].diameter_resolved);
+  EXPECT_DOUBLE_EQ(msg.measurements[1].diameter_min, 0.004);
+  EXPECT_DOUBLE_EQ(msg.measurements[1].diameter_max, 0.0091);
+  // DELETEALL; the trunk's cylinder and label; each branch's cylinder and label.
+  const auto markers = ros_layer::toMarkers(model, header);
+  ASSERT_EQ(markers.markers.size(), 7u);
+  EXPECT_EQ(markers.markers[2].text, "4.0 cm");
+  EXPECT_EQ(markers.markers[4].text, "2.1 cm");
+  EXPECT_EQ(markers.markers[6].text, "0.4-0.9 cm");
+  const auto grey = [](const std_msgs::ColorRGBA& c) { return c.r == c.g && c.g == c.b; };
+  EXPECT_FALSE(grey(markers.markers[3].color));
+  EXPECT_TRUE(grey(markers.markers[5].color));
 }
 
 }  // namespace
