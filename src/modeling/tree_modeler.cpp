@@ -87,6 +87,11 @@ std::vector<std::string> preprocessNotices(const PreprocessStats& s, std::size_t
 /// A branch radius within this share above MIN_BRANCH_RADIUS_M is the floor, not a measurement.
 constexpr double FLOOR_TOLERANCE = 1.0 + 1e-6;
 
+/// Whether a branch radius is the floor the noise correction stops at.
+bool atFloor(double radius) {
+  return radius <= MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE;
+}
+
 /// How far outside a calibration's covered radii and noise a tree may go before the model says
 /// the tables were held constant there: a rod's or a section's neighbourhood.
 constexpr double COVERAGE_NOISE_SLACK = 0.25;
@@ -156,13 +161,17 @@ DiameterCorrection describeCalibration(const ModelerConfig& config, const TreeMo
 }
 
 /// The branches whose diameter is no measurement (empty when none): at the floor, or read as
-/// thinner branches read too (`sigma` as the tables read the noise).
-std::string floorWarning(const TreeModel& model, const ModelerConfig& config,
-                         double estimated_sigma, double sigma) {
+/// thinner branches read too, up to the widest diameter_max they were given (the tables'
+/// reach at the tree's noise).
+std::string floorWarning(const TreeModel& model, double estimated_sigma) {
   std::size_t unresolved = 0, at_floor = 0;
+  double widest = 0.0;
   for (const auto& b : model.primary_branches) {
-    unresolved += !b.measurement.diameter_resolved;
-    at_floor += b.cylinder.diameter <= 2 * MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE;
+    if (b.measurement.diameter_resolved)
+      continue;
+    ++unresolved;
+    at_floor += atFloor(0.5 * b.cylinder.diameter);
+    widest = std::max(widest, b.measurement.diameter_max);
   }
   if (unresolved == 0)
     return {};
@@ -174,11 +183,9 @@ std::string floorWarning(const TreeModel& model, const ModelerConfig& config,
                 2000 * MIN_BRANCH_RADIUS_M);
   std::string out = text;
   if (unresolved > at_floor) {
-    const double reach =
-        config.branch_calibration.floorAmbiguity(MIN_BRANCH_RADIUS_M, sigma).radius;
     std::snprintf(text, sizeof(text),
                   ", %zu where the tables read diameters of %.0f to %.1f mm alike",
-                  unresolved - at_floor, 2000 * MIN_BRANCH_RADIUS_M, 2000 * reach);
+                  unresolved - at_floor, 2000 * MIN_BRANCH_RADIUS_M, 1000 * widest);
     out += text;
   }
   return out;
@@ -190,7 +197,7 @@ std::string floorWarning(const TreeModel& model, const ModelerConfig& config,
 DiameterCorrection describeCorrection(const ModelerConfig& config, const TreeModel& model,
                                       double estimated_sigma, double sigma) {
   DiameterCorrection d = describeCalibration(config, model, estimated_sigma, sigma);
-  const std::string floor = floorWarning(model, config, estimated_sigma, sigma);
+  const std::string floor = floorWarning(model, estimated_sigma);
   if (!floor.empty())
     d.warnings.push_back(floor);
   return d;
@@ -341,7 +348,7 @@ std::vector<CylinderModel> trunkCylinders(const Points& pts, const std::vector<i
 /// corrected it, read wider than every radius they cannot tell from the floor (a wide beam
 /// reads thin branches of several radii alike).
 bool diameterResolved(double radius, const TrunkModel& trunk, const ModelerConfig& config) {
-  if (radius <= MIN_BRANCH_RADIUS_M * FLOOR_TOLERANCE)
+  if (atFloor(radius))
     return false;
   return !config.branchTableCorrects() ||
          config.branch_calibration.resolves(radius, trunk.table_sigma, MIN_BRANCH_RADIUS_M);
