@@ -277,6 +277,9 @@ constexpr int MIN_ARC_POINTS = 2 * MIN_THIN_POINTS;
 // across by what bounds the part (the trunk's bark at a branch's base, the part's far end),
 // so their centres are the least sure and, at the ends of the line, weigh the most.
 constexpr std::size_t MIN_SLICES_WITHOUT_ENDS = 5;
+// From this many centres on, the one farthest off the line through the others may be left out
+// (dropStraySlice): three still fix the line.
+constexpr std::size_t MIN_SLICES_FOR_STRAY = 4;
 // A raw radius is this quantile of the slices' moments, taper taken out: shoots and spurs on a
 // branch add to the moments of the slices they cross and never take from any, so a median
 // reads a branch with shoots thicker than the rig's bare rods it is calibrated on. The tables
@@ -373,12 +376,43 @@ Eigen::Vector3d sliceCentre(const Points& pts, const std::vector<int>& slice,
   return centroid + circle->center.x() * u + circle->center.y() * v;
 }
 
+/// Leaves out the slice centre farthest from the line through the other centres when it lies
+/// farther from it than `radius`: that slice's points are mostly outside the branch, so it is
+/// not the branch's cross-section but a side shoot, a secondary at a fork, or one beside the
+/// end of a piece that a crossing branch's extraction cut off. With few slices one such centre
+/// turns the line through all of them by 10-15 degrees, off the branch. A branch's own centres
+/// stray by its bend and their noise, millimetres.
+void dropStraySlice(Points& centres, double radius) {
+  if (centres.size() < MIN_SLICES_FOR_STRAY)
+    return;
+  double worst = 0.0;
+  std::size_t stray = 0;
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    Points others;
+    for (std::size_t j = 0; j < centres.size(); ++j) {
+      if (j != k)
+        others.push_back(centres[j]);
+    }
+    Eigen::Vector3d c;
+    const Eigen::Vector3d d = principalAxis(others, &c);
+    const Eigen::Vector3d w = centres[k] - c;
+    const double off = (w - w.dot(d) * d).norm();
+    if (off > worst) {
+      worst = off;
+      stray = k;
+    }
+  }
+  if (worst > radius)
+    centres.erase(centres.begin() + static_cast<std::ptrdiff_t>(stray));
+}
+
 /// The points of `best` within `reach` of the axis (empty below MIN_THIN_POINTS), and the axis
 /// moved onto the line through their slices' centres (sliceCentre; a full cross-section's
-/// centroid is its centre) when that stays within 30 degrees.
+/// centroid is its centre; dropStraySlice with the current `radius`) when that stays within 30
+/// degrees.
 std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
-                          const Eigen::Vector3d& axis_guess, double reach, double arc_radius,
-                          Cylinder* cyl) {
+                          const Eigen::Vector3d& axis_guess, double reach, double radius,
+                          double arc_radius, Cylinder* cyl) {
   std::vector<int> used;
   std::map<long, std::vector<int>> slices;
   for (const int i : best) {
@@ -398,6 +432,7 @@ std::vector<int> recentre(const Points& pts, const std::vector<int>& best,
   }
   if (centres.size() >= MIN_SLICES_WITHOUT_ENDS)
     centres = Points(centres.begin() + 1, centres.end() - 1);
+  dropStraySlice(centres, radius);
   if (centres.size() >= 2) {
     Eigen::Vector3d c;
     Eigen::Vector3d d = principalAxis(centres, &c);
@@ -615,7 +650,7 @@ std::optional<Cylinder> fitThinCylinder(const Points& pts, const Eigen::Vector3d
         raw ? std::sqrt(std::max(0.0, radius * radius - sigma * sigma)) : radius;
     const bool arc = round > 0 && noiseless >= ARC_MIN_SIGMAS * std::max(sigma, scatter);
     const double arc_radius = arc ? radius : 0.0;
-    used = recentre(pts, best, axis_guess, reach, arc_radius, &cyl);
+    used = recentre(pts, best, axis_guess, reach, radius, arc_radius, &cyl);
     if (used.empty())
       return std::nullopt;
     BentAxis bent(pts, used, cyl, arc_radius);
