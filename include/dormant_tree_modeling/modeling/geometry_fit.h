@@ -125,10 +125,12 @@ double noiseCorrectedRadius(const Cylinder& c, const Points& pts, double sigma, 
 
 /// @brief Cylinder for thin, noisy branches, where a RANSAC circle band would be wider than the
 /// radius: a RANSAC line (band: max_radius + 2.5 sigma) refined by PCA on its inliers and moved
-/// onto its slices' centroids, and the radius from the scatter-corrected second moment
-/// sqrt(mean d^2 - scatter^2), d measured from the axis bent (a parabola) through those
-/// centroids; a branch 2 sigmas thicker than the noise is centred on the circle its
-/// cross-sections lie on instead (a one-sided view pulls the centroids towards the scanner).
+/// onto its slices' centroids (a slice whose centre lies farther off the line through the
+/// others than the radius left out: a shoot or a secondary beside the branch), and the radius from
+/// the scatter-corrected second moment sqrt(mean d^2 - scatter^2), d measured from the axis bent (a
+/// parabola) through those centroids; a branch 2 sigmas thicker than the noise is centred on the
+/// circle its cross-sections lie on instead (a one-sided view pulls the centroids towards the
+/// scanner).
 /// @param sigma range noise: sets the bands (m)
 /// @param scatter total scatter removed from the moment (noise and beam spread), the median
 ///        over slices; 0: the raw RMS distance from the axis, a low quantile over slices with
