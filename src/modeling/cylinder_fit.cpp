@@ -387,16 +387,17 @@ void dropStraySlice(Points& centres, double radius) {
     return;
   double worst = 0.0;
   std::size_t stray = 0;
+  Points others;
+  others.reserve(centres.size() - 1);
   for (std::size_t k = 0; k < centres.size(); ++k) {
-    Points others;
+    others.clear();
     for (std::size_t j = 0; j < centres.size(); ++j) {
       if (j != k)
         others.push_back(centres[j]);
     }
-    Eigen::Vector3d c;
-    const Eigen::Vector3d d = principalAxis(others, &c);
-    const Eigen::Vector3d w = centres[k] - c;
-    const double off = (w - w.dot(d) * d).norm();
+    Cylinder line;
+    line.axis = principalAxis(others, &line.center);
+    const double off = axisDistance(line, centres[k]);
     if (off > worst) {
       worst = off;
       stray = k;
