@@ -274,6 +274,46 @@ bool sameBranch(const BranchFit& a, const BranchFit& b) {
          (ca.center - cb.center).norm() < DUPLICATE_REACH;
 }
 
+std::vector<int> branchBasePoints(const Points& pts, const std::vector<int>& region,
+                                  const TrunkModel& trunk, const std::vector<BranchFit>& branches,
+                                  double band) {
+  struct Base {
+    Eigen::Vector3d from, to;  // where the way from the attachment leaves the trunk; near end
+    double radius;
+    double z_min, z_max;  // of the tube
+  };
+  std::vector<Base> bases;
+  for (const auto& b : branches) {
+    const Eigen::Vector3d near_end = b.cylinder.center - 0.5 * b.cylinder.length * b.cylinder.axis;
+    const Eigen::Vector3d way = near_end - b.attachment;
+    const double trunk_radius = 0.5 * trunk.diameterAt(trunk.centerline.project(b.attachment));
+    const Eigen::Vector3d from =
+        way.norm() > trunk_radius ? Eigen::Vector3d(b.attachment + trunk_radius * way.normalized())
+                                  : near_end;
+    const double r = b.cylinder.radius;
+    bases.push_back({from, near_end, r, std::min(from.z(), near_end.z()) - r,
+                     std::max(from.z(), near_end.z()) + r});
+  }
+  std::vector<int> out;
+  for (const int k : region) {
+    const Eigen::Vector3d& p = pts[k];
+    double d = 0.0;
+    const double s = trunk.centerline.project(p, &d);
+    const double off_trunk = d - 0.5 * trunk.diameterAt(s);
+    if (off_trunk <= band)
+      continue;
+    for (const auto& b : bases) {
+      if (p.z() < b.z_min - off_trunk || p.z() > b.z_max + off_trunk)
+        continue;
+      if (std::abs(segmentDistance(p, b.from, b.to) - b.radius) < off_trunk) {
+        out.push_back(k);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
 std::vector<BranchFit> modelBranches(const Points& pts, const PointIndex& index,
                                      const TrunkModel& trunk, const std::vector<int>& region,
                                      const ModelerConfig& config,

@@ -1,4 +1,5 @@
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -50,6 +51,14 @@ double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 double axisDistance(const Cylinder& c, const Eigen::Vector3d& p) {
   const Eigen::Vector3d w = p - c.center;
   return (w - w.dot(c.axis) * c.axis).norm();
+}
+
+double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (p - (a + t * ab)).norm();
 }
 
 Eigen::Vector3d principalAxis(const Points& pts, Eigen::Vector3d* centroid,

@@ -144,6 +144,10 @@ void addTrunk(ConfigTable<ModelerConfig>& t) {
            "With noise.correct_bias: segment radii from one robust taper profile over all "
            "slices, not each segment's median slice.")
       .formerly("trunk_taper_profile")
+      .add("trunk.without_branch_bases", &T::without_branch_bases,
+           "Once the branches are found, the trunk is measured again without the returns "
+           "nearer a found branch's surface (its axis carried back to the trunk axis) than the "
+           "trunk's.")
       .add("trunk.radius_continuity", &T::radius_continuity, 0.01, 10.0,
            "A segment's radius within this share of its neighbour's.");
 }
@@ -268,6 +272,7 @@ ModelerConfig ModelerConfig::paper() {
   c.trunk.max_bend_m = 0.0;
   c.trunk.max_segment_length_m = 0.0;
   c.trunk.taper_profile = false;
+  c.trunk.without_branch_bases = false;
   c.branches.ray_split = false;
   c.branches.keep_cut_off = false;
   c.branches.merge_curved = false;

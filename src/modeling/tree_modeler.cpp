@@ -402,6 +402,25 @@ int dropPointsOn(const std::vector<char>& on, std::vector<int>* region) {
   return dropped;
 }
 
+/// The trunk measured again on its region without the found branches' bases
+/// (branchBasePoints), with the noise read the first time: the branches were searched and
+/// measured at that reading. The first model stays when none are found or the second fails.
+TrunkModel withoutBranchBases(const Points& pts, const TrunkRegion& region, const TrunkModel& trunk,
+                              const std::vector<BranchFit>& branches, const ModelerConfig& config) {
+  std::vector<char> base(pts.size(), 0);
+  for (const int k :
+       branchBasePoints(pts, region.points, trunk, branches, trunkSurfaceBand(trunk, config)))
+    base[k] = 1;
+  std::vector<int> points = region.points;
+  if (dropPointsOn(base, &points) == 0)
+    return trunk;
+  try {
+    return modelTrunk(pts, points, region.axis, region.radius, config, region.radii, &trunk);
+  } catch (const Error&) {
+    return trunk;
+  }
+}
+
 }  // namespace
 
 ModelerConfig stageConfig(const ModelerConfig& config) {
@@ -494,6 +513,9 @@ ModelResult TreeModeler::model(const Points& input) const {
       modelBranches(pts, index, trunk, region.points, config_, &result.rejected_branches,
                     result.preprocess.wire_directions, on_columns);
   watch.lap("branches");
+  if (config_.trunk.without_branch_bases)
+    trunk = withoutBranchBases(pts, region, trunk, branches, config_);
+  watch.lap("trunk_again");
 
   TreeModel& model = result.model;
   model.input_points = input.size();

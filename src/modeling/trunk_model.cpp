@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iterator>
 #include <limits>
 #include <optional>
@@ -1186,6 +1188,18 @@ void endWhereTheSurfaceEnds(const Points& pts, const std::vector<int>& region,
     trunk.partitions.push_back(top);
 }
 
+/// Slices along a given centreline.
+SlicedAxis slicesAlong(const Points& pts, const std::vector<int>& region, const Centerline& line,
+                       const SliceBounds& bounds, const TrackedAxis& track,
+                       const ModelerConfig& config) {
+  SlicedAxis out{line, std::vector<double>(region.size()), std::vector<double>(region.size()), {}};
+  projectRegion(pts, region, out.line, out.s, out.dist);
+  out.slices =
+      computeSlices(pts, region, out, SliceLimits{config.fit.circle_threshold_m, bounds, &track},
+                    std::nullopt, config);
+  return out;
+}
+
 /// Slices on the initial axis, then CENTERLINE_ROUNDS rounds of refining the centreline on
 /// their circles and slicing again.
 SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
@@ -1193,16 +1207,11 @@ SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
                          const TrackedAxis& track, double initial_radius,
                          const ModelerConfig& config) {
   const double h = config.trunk.slice_height_m;
-  SlicedAxis out{
-      initial, std::vector<double>(region.size()), std::vector<double>(region.size()), {}};
-  for (int round = 0; round <= CENTERLINE_ROUNDS; ++round) {
-    if (round > 0)
-      out.line = refineCenterline(out.slices, out.line,
-                                  std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
-    projectRegion(pts, region, out.line, out.s, out.dist);
-    out.slices =
-        computeSlices(pts, region, out, SliceLimits{config.fit.circle_threshold_m, bounds, &track},
-                      std::nullopt, config);
+  SlicedAxis out = slicesAlong(pts, region, initial, bounds, track, config);
+  for (int round = 1; round <= CENTERLINE_ROUNDS; ++round) {
+    const Centerline refined =
+        refineCenterline(out.slices, out.line, std::max(initial_radius, CENTERLINE_MIN_RADIUS), h);
+    out = slicesAlong(pts, region, refined, bounds, track, config);
   }
   return out;
 }
@@ -1243,7 +1252,8 @@ TrunkMembership trunkMembership(const Points& pts, const std::vector<int>& regio
 
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
-                      const ModelerConfig& config, const std::vector<double>& axis_radii) {
+                      const ModelerConfig& config, const std::vector<double>& axis_radii,
+                      const TrunkModel* earlier) {
   if (initial_axis.size() < 2 || region.size() < static_cast<std::size_t>(MIN_SLICE_POINTS)) {
     throw Error(ErrorCode::NO_TRUNK, "no trunk: too few trunk points to model");
   }
@@ -1256,18 +1266,28 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   // centreline, with or without a track: the calibration rig's sections are read alike (one
   // section, no track). The range noise skips the slices off the track; the bands and gates
   // that pick among clutter were set on every slice's scatter.
-  SlicedAxis sliced =
-      refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
-  const TrunkNoise noise = trunkNoise(pts, region, sliced.line, sliced.slices, track, config);
+  SlicedAxis sliced;
+  TrunkNoise noise{};
+  if (earlier) {
+    noise = {earlier->noise_sigma, earlier->search_sigma, {}};
+  } else {
+    sliced = refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
+    noise = trunkNoise(pts, region, sliced.line, sliced.slices, track, config);
+  }
   const double sigma = noise.range;
   trunk.search_sigma = noise.search;
-  if (!track.empty())
+  if (earlier)
+    sliced = slicesAlong(pts, region, earlier->centerline, bounds, track, config);
+  else if (!track.empty())
     sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
   trunk.noise_sigma = sigma;
   // Raw radii (calibrate_diameters measuring a rig) key their rows on the rig's own reading.
-  trunk.table_sigma = config.noise.correct_bias && !config.branches.raw_radius
-                          ? standardNoiseReading(config, sigma, noise.slice_radii)
-                          : sigma;
+  if (earlier)
+    trunk.table_sigma = earlier->table_sigma;
+  else if (config.noise.correct_bias && !config.branches.raw_radius)
+    trunk.table_sigma = standardNoiseReading(config, sigma, noise.slice_radii);
+  else
+    trunk.table_sigma = sigma;
   const double scatter =
       config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;
   trunk.scatter = scatter;
@@ -1291,7 +1311,7 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   trunk.slices = sliced.slices;
   trunk.centerline = sliced.line;
   const SegmentContext segments{pts, region, sliced, bounds, cylinder_threshold, scatter, config};
-  trunk.partitions = trunkCuts(segments);
+  trunk.partitions = earlier ? earlier->partitions : trunkCuts(segments);
   fitCylinders(segments, trunk);
   if (trunk.cylinders.empty())
     throw Error(ErrorCode::NO_TRUNK, "no trunk: no trunk cylinder could be fitted");

@@ -72,6 +72,16 @@ bool sameBranch(const BranchFit& a, const BranchFit& b);
 /// axis line as well, but a trunk's width beyond the ends.
 bool curvedPieces(const BranchFit& a, const BranchFit& b);
 
+/// @brief The points of `region` nearer a found branch's surface than the trunk's: each branch
+/// is a tube of its radius about its axis carried back from its near end to its attachment on
+/// the trunk axis, the trunk one of trunk.diameterAt() about its centreline. These are the
+/// branch bases a slice through a whorl takes in: they widen its circle.
+/// @param region indices into `pts`
+/// @return a subset of `region`, in its order
+std::vector<int> branchBasePoints(const Points& pts, const std::vector<int>& region,
+                                  const TrunkModel& trunk, const std::vector<BranchFit>& branches,
+                                  double band);
+
 /// @brief Algorithm 3 step 5. Candidate points are, in the paper's way, the points of `region`
 /// (trunk and primary-branch clusters) off their trunk segment's cylinder; with
 /// config.branches.shell, every point of the cloud in a shell around the trunk cylinders.

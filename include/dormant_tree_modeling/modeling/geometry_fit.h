@@ -33,6 +33,10 @@ struct Cylinder {
 /// @brief Distance of p to the infinite axis of c.
 double axisDistance(const Cylinder& c, const Eigen::Vector3d& p);
 
+/// @brief Distance of p to the segment from a to b (to a when they coincide).
+double segmentDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b);
+
 /// @brief The angle (rad) between two lines along unit directions a and b, their signs
 /// ignored: in [0, pi/2].
 double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b);

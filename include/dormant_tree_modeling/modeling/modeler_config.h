@@ -80,6 +80,10 @@ struct TrunkConfig {
   /// With noise.correct_bias: segment radii from one smooth taper profile fitted to all slices
   /// (robust to slices through branch bases), not each segment's median slice.
   bool taper_profile = true;
+  /// (past the paper) Once the branches are found, the trunk is measured again without the
+  /// returns nearer a found branch's surface (its axis carried back to the trunk axis) than
+  /// the trunk's: slices through a whorl's branch bases read centimetres wide.
+  bool without_branch_bases = true;
   double radius_continuity = 0.35;  ///< a segment's radius within this share of its neighbour's
 };
 

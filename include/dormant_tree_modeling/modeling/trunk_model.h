@@ -241,13 +241,17 @@ TrunkMembership trunkMembership(const Points& pts, const std::vector<int>& regio
 ///        none; where given, a slice's circle stays within 0.3x..2.5x of the median of the
 ///        radii within 15 cm of it, and its centre within 0.3 such radii of the centreline
 ///        (the noise estimate still reads slices bounded by initial_radius alone)
+/// @param earlier an earlier model of this trunk, or null: its centreline, its noise readings
+///        (noise_sigma, search_sigma, table_sigma) and its partitions are kept instead of
+///        being found again (the trunk measured again on fewer of its points)
 /// @return the trunk up to its highest cylinder whose surface holds MIN_TRUNK_SURFACE_SHARE of
 ///         its stretch's returns, judged before a segment's radius is bounded by the one below
 ///         (the lowest cylinder is always kept)
 /// @throws Error NO_TRUNK when no trunk cylinder can be fitted
 TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
                       const std::vector<Eigen::Vector3d>& initial_axis, double initial_radius,
-                      const ModelerConfig& config, const std::vector<double>& axis_radii = {});
+                      const ModelerConfig& config, const std::vector<double>& axis_radii = {},
+                      const TrunkModel* earlier = nullptr);
 
 }  // namespace modeling
 }  // namespace dormant_tree_modeling
