@@ -146,8 +146,8 @@ void addTrunk(ConfigTable<ModelerConfig>& t) {
       .formerly("trunk_taper_profile")
       .add("trunk.without_branch_bases", &T::without_branch_bases,
            "Once the branches are found, the trunk is measured again without the returns "
-           "nearer a found branch's surface (its axis carried back to the trunk axis) than the "
-           "trunk's.")
+           "beyond its surface band that lie nearer a found branch's surface (its axis carried "
+           "back to the trunk) than the trunk's.")
       .add("trunk.radius_continuity", &T::radius_continuity, 0.01, 10.0,
            "A segment's radius within this share of its neighbour's.");
 }

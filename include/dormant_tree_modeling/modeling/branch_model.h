@@ -72,11 +72,14 @@ bool sameBranch(const BranchFit& a, const BranchFit& b);
 /// axis line as well, but a trunk's width beyond the ends.
 bool curvedPieces(const BranchFit& a, const BranchFit& b);
 
-/// @brief The points of `region` nearer a found branch's surface than the trunk's: each branch
-/// is a tube of its radius about its axis carried back from its near end to its attachment on
-/// the trunk axis, the trunk one of trunk.diameterAt() about its centreline. These are the
-/// branch bases a slice through a whorl takes in: they widen its circle.
+/// @brief The points of `region` beyond the trunk's surface band and nearer a found branch's
+/// surface than the trunk's: each branch is a tube of its radius about the way from its
+/// attachment to its fit's near end, from where that way leaves the trunk; the trunk is a tube
+/// of trunk.diameterAt() about its centreline. These are the branch bases a slice through a
+/// whorl takes in: they widen its circle.
 /// @param region indices into `pts`
+/// @param band how far off the trunk's surface (m) a point may lie and stay the trunk's
+/// (trunkSurfaceBand): the trunk's own returns pushed outward by the noise
 /// @return a subset of `region`, in its order
 std::vector<int> branchBasePoints(const Points& pts, const std::vector<int>& region,
                                   const TrunkModel& trunk, const std::vector<BranchFit>& branches,

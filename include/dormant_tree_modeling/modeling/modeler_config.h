@@ -81,8 +81,9 @@ struct TrunkConfig {
   /// (robust to slices through branch bases), not each segment's median slice.
   bool taper_profile = true;
   /// (past the paper) Once the branches are found, the trunk is measured again without the
-  /// returns nearer a found branch's surface (its axis carried back to the trunk axis) than
-  /// the trunk's: slices through a whorl's branch bases read centimetres wide.
+  /// returns beyond its surface band that lie nearer a found branch's surface (its axis carried
+  /// back to the trunk) than the trunk's: slices through a whorl's branch bases read
+  /// centimetres wide.
   bool without_branch_bases = true;
   double radius_continuity = 0.35;  ///< a segment's radius within this share of its neighbour's
 };
