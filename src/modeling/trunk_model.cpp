@@ -1260,32 +1260,29 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   const Centerline initial(initial_axis.size() >= 3 ? smoothAxis(initial_axis, h) : initial_axis);
   const SliceBounds bounds = sliceBounds(initial_radius);
   const TrackedAxis track(initial, initial_axis, axis_radii);
-  // The noise is read on slices bounded by the trunk-wide radius alone and about their own
-  // centreline, with or without a track: the calibration rig's sections are read alike (one
-  // section, no track). The range noise skips the slices off the track; the bands and gates
-  // that pick among clutter were set on every slice's scatter.
   SlicedAxis sliced;
-  TrunkNoise noise{};
   if (earlier) {
-    noise = {earlier->noise_sigma, earlier->search_sigma, {}};
-  } else {
-    sliced = refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
-    noise = trunkNoise(pts, region, sliced.line, sliced.slices, track, config);
-  }
-  const double sigma = noise.range;
-  trunk.search_sigma = noise.search;
-  if (earlier)
-    sliced = slicesAlong(pts, region, earlier->centerline, bounds, track, config);
-  else if (!track.empty())
-    sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
-  trunk.noise_sigma = sigma;
-  // Raw radii (calibrate_diameters measuring a rig) key their rows on the rig's own reading.
-  if (earlier)
+    trunk.noise_sigma = earlier->noise_sigma;
+    trunk.search_sigma = earlier->search_sigma;
     trunk.table_sigma = earlier->table_sigma;
-  else if (config.noise.correct_bias && !config.branches.raw_radius)
-    trunk.table_sigma = standardNoiseReading(config, sigma, noise.slice_radii);
-  else
-    trunk.table_sigma = sigma;
+    sliced = slicesAlong(pts, region, earlier->centerline, bounds, track, config);
+  } else {
+    // The noise is read on slices bounded by the trunk-wide radius alone and about their own
+    // centreline, with or without a track: the calibration rig's sections are read alike (one
+    // section, no track). The range noise skips the slices off the track; the bands and gates
+    // that pick among clutter were set on every slice's scatter.
+    sliced = refinedSlices(pts, region, initial, bounds, TrackedAxis{}, initial_radius, config);
+    const TrunkNoise noise = trunkNoise(pts, region, sliced.line, sliced.slices, track, config);
+    trunk.noise_sigma = noise.range;
+    trunk.search_sigma = noise.search;
+    // Raw radii (calibrate_diameters measuring a rig) key their rows on the rig's own reading.
+    trunk.table_sigma = config.noise.correct_bias && !config.branches.raw_radius
+                            ? standardNoiseReading(config, noise.range, noise.slice_radii)
+                            : noise.range;
+    if (!track.empty())
+      sliced = refinedSlices(pts, region, initial, bounds, track, initial_radius, config);
+  }
+  const double sigma = trunk.noise_sigma;
   const double scatter =
       config.noise.correct_bias ? std::hypot(sigma, config.noise.beam_spread_m) : 0.0;
   trunk.scatter = scatter;

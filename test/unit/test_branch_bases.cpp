@@ -104,9 +104,10 @@ TEST(BranchBases, OnlyBranchReturnsBeyondTheTrunkBandAreBases) {
       const bool before_the_fit = (p - near_end).dot(b.cylinder.axis) < 0.0;
       const bool beside_this_branch = axisDistance(b.cylinder, p) < 2 * BUILT.branch_radius;
       if (before_the_fit && beside_this_branch &&
-          p.head<2>().norm() > BUILT.trunk_radius + 1.5 * band)
+          p.head<2>().norm() > BUILT.trunk_radius + 1.5 * band) {
         EXPECT_TRUE(is_base[k]) << "a base return " << 1000 * p.head<2>().norm()
                                 << " mm off the trunk axis was left in the trunk";
+      }
     }
   }
 }
