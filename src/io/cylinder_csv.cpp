@@ -40,5 +40,18 @@ std::string cylindersToCsv(const modeling::TreeModel& model, const Eigen::Vector
   return out;
 }
 
+std::string turnedDownToCsv(const std::vector<modeling::RejectedBranch>& rejected,
+                            const Eigen::Vector3d& offset) {
+  std::string out = "centroid_x,centroid_y,centroid_z,points,reason,budget_spent\n";
+  for (const auto& r : rejected) {
+    char buf[192];
+    const Eigen::Vector3d p = r.centroid + offset;
+    std::snprintf(buf, sizeof(buf), "%.6f,%.6f,%.6f,%d,%s,%d\n", p.x(), p.y(), p.z(), r.points,
+                  modeling::branchRejectionText(r.reason), r.budget_spent ? 1 : 0);
+    out += buf;
+  }
+  return out;
+}
+
 }  // namespace io
 }  // namespace dormant_tree_modeling

@@ -40,10 +40,10 @@ int exitCode(ErrorCode code) {
 // Long by design: the options in the order --help lists them, then model, write and the
 // verbose report, each a few lines.
 int main(int argc, char** argv) {
-  std::string input, output, params, csv, picture, calibration;
+  std::string input, output, params, csv, turned_down, picture, calibration;
   po::options_description desc(
-      "Usage: tree_model INPUT --output model.json [--params FILE] [--csv FILE] [--picture PNG] "
-      "[--calibration FILE] [--paper]\n"
+      "Usage: tree_model INPUT --output model.json [--params FILE] [--csv FILE] [--turned-down "
+      "FILE] [--picture PNG] [--calibration FILE] [--paper]\n"
       "Models the trunk and primary branches of the tree in INPUT (.pcd, .ply, or x y z text)");
   desc.add_options()("help,h", "this help")("input", po::value(&input), "input cloud")(
       "output,o", po::value(&output), "model JSON to write (docs/evaluation.md)")(
@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
       "the scanner's diameter calibration (calibrate_diameters; config/calibration/). Without "
       "one, radii are corrected for range noise only")("csv", po::value(&csv),
                                                        "also write the cylinders as CSV")(
+      "turned-down", po::value(&turned_down),
+      "also write the branch candidates turned down, where and why, as CSV")(
       "picture", po::value(&picture), "also render the cylinders over the cloud (front view, PNG)")(
       "paper", "the paper's method only (every improvement switched off), for comparisons")(
       "verbose,v", "print stage timings and diagnostics to stderr");
@@ -93,6 +95,8 @@ int main(int argc, char** argv) {
     io::writeTextFile(output, io::modelToJson(result.model, cloud.offset));
     if (!csv.empty())
       io::writeTextFile(csv, io::cylindersToCsv(result.model, cloud.offset));
+    if (!turned_down.empty())
+      io::writeTextFile(turned_down, io::turnedDownToCsv(result.rejected_branches, cloud.offset));
     if (!picture.empty())
       simulation::renderModelPreview(*cloud.cloud, result.model, picture);
     if (vm.count("verbose")) {

@@ -121,7 +121,9 @@ TEST(TreeModelTool, ModelsARealCloudAndEvaluateModelScoresIt) {
   test::TempDir dir;
   std::string out;
   ASSERT_EQ(run("tree_model",
-                tree + " --output " + dir.file("m.json") + " --csv " + dir.file("c.csv"), &out),
+                tree + " --output " + dir.file("m.json") + " --csv " + dir.file("c.csv") +
+                    " --turned-down " + dir.file("t.csv"),
+                &out),
             0)
       << out;
   const auto model = io::readModelFile(dir.file("m.json"));
@@ -132,6 +134,10 @@ TEST(TreeModelTool, ModelsARealCloudAndEvaluateModelScoresIt) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("role,id,parent_id,center_x", 0), 0u);
+  // The turned-down file is written with its header (this tree's search turns none down).
+  std::ifstream turned_down(dir.file("t.csv"));
+  std::getline(turned_down, header);
+  EXPECT_EQ(header, "centroid_x,centroid_y,centroid_z,points,reason,budget_spent");
   // A truth that is the model's own trunk: the evaluation runs and prints a row.
   evaluation::GroundTruth truth;
   for (const auto& c : model.trunk) {
@@ -180,6 +186,23 @@ TEST(CylinderCsv, OneRowPerCylinderWithBranchColumns) {
   EXPECT_EQ(std::count(header.begin(), header.end(), ','),
             std::count(branch.begin(), branch.end(), ','));
   EXPECT_NE(branch.find(",0.400,0,0,0.00400,0.02150"), std::string::npos) << branch;
+}
+
+TEST(CylinderCsv, TurnedDownCandidatesGiveWhereAndWhy) {
+  modeling::RejectedBranch near_trunk;
+  near_trunk.centroid = Eigen::Vector3d(-0.25, 0.5, 1.125);
+  near_trunk.points = 644;
+  near_trunk.reason = modeling::BranchRejection::NOT_AT_THE_SURFACE;
+  modeling::RejectedBranch left;
+  left.points = 90;
+  left.reason = modeling::BranchRejection::REMAINDER_NOT_SEARCHED;
+  left.budget_spent = true;
+  EXPECT_EQ(io::turnedDownToCsv({near_trunk, left}, Eigen::Vector3d(100, 0, 0)),
+            "centroid_x,centroid_y,centroid_z,points,reason,budget_spent\n"
+            "99.750000,0.500000,1.125000,644,not at the surface,0\n"
+            "100.000000,0.000000,0.000000,90,remainder not searched,1\n");
+  EXPECT_EQ(io::turnedDownToCsv({}),
+            "centroid_x,centroid_y,centroid_z,points,reason,budget_spent\n");
 }
 
 TEST(RenderModelTool, FarPointsAreSkippedAndAModelThatIsNoTreeIsRefused) {

@@ -2,7 +2,9 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
+#include "dormant_tree_modeling/modeling/branch_model.h"
 #include "dormant_tree_modeling/modeling/tree_model.h"
 
 namespace dormant_tree_modeling {
@@ -15,6 +17,14 @@ namespace io {
 /// are empty for trunk rows.
 std::string cylindersToCsv(const modeling::TreeModel& model,
                            const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
+
+/// @brief The branch candidates the search turned down as CSV, one per row under the header
+/// centroid_x,centroid_y,centroid_z,points,reason,budget_spent: where a branch a user sees in
+/// the cloud went, and why it is not in the model.
+/// @param rejected the modeler's turned-down candidates (ModelResult::rejected_branches)
+/// @param offset added to the centroids, as to the cylinders' centres
+std::string turnedDownToCsv(const std::vector<modeling::RejectedBranch>& rejected,
+                            const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
 
 }  // namespace io
 }  // namespace dormant_tree_modeling
