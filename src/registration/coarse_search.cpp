@@ -77,6 +77,9 @@ struct Shift {
   double yaw = 0;
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   double score = 0;
+  // The best shift at least second_place_m from the best one (score 0: none).
+  Eigen::Vector3d second_translation = Eigen::Vector3d::Zero();
+  double second_score = 0;
 };
 
 Eigen::Isometry3d poseOf(double yaw, const Eigen::Vector3d& t) {
@@ -219,6 +222,9 @@ Shift bestShift(const Points& source, const Columns& grid, double yaw, const Eig
   const Eigen::Isometry3d pose = poseOf(yaw, base);
   const SourceColumns cols = sourceColumns(source, grid, pose, c.cell_m);
   const int w = static_cast<int>(std::ceil(c.xy_window_m / c.cell_m));
+  const int side = 2 * w + 1;
+  // Per horizontal shift, its best height's score and shift.
+  std::vector<Shift> at(static_cast<std::size_t>(side) * side);
   Shift s;
   s.yaw = yaw;
   for (const int dz : dzs) {
@@ -232,13 +238,26 @@ Shift bestShift(const Points& source, const Columns& grid, double yaw, const Eig
           hits += __builtin_popcountll(
               shifted[i] & grid.at(cols.cells[i].first + dx, cols.cells[i].second + dy));
         const double score = static_cast<double>(hits) / std::max(cols.occupied, 1);
+        const Eigen::Vector3d t(dx * c.cell_m, dy * c.cell_m, dz * grid.slab);
+        Shift& here = at[static_cast<std::size_t>(dy + w) * side + (dx + w)];
+        if (score > here.score) {
+          here.score = score;
+          here.translation = t;
+        }
         if (score > s.score ||
             (score == s.score &&
              dx * dx + dy * dy < s.translation.head<2>().squaredNorm() / (c.cell_m * c.cell_m))) {
           s.score = score;
-          s.translation = Eigen::Vector3d(dx * c.cell_m, dy * c.cell_m, dz * grid.slab);
+          s.translation = t;
         }
       }
+    }
+  }
+  for (const Shift& other : at) {
+    const double apart = (other.translation - s.translation).head<2>().norm();
+    if (apart >= c.second_place_m && other.score > s.second_score) {
+      s.second_score = other.score;
+      s.second_translation = other.translation + pose.translation();
     }
   }
   s.translation += pose.translation();
@@ -302,6 +321,18 @@ CoarseCandidate refineIn3d(const Points& source, const std::unordered_set<std::u
   return best;
 }
 
+// The best heading's second place, refined in 3-D, when its footprints overlap at all.
+std::optional<CoarseCandidate> secondPlace(const std::vector<Shift>& picked, const Points& source,
+                                           const std::unordered_set<std::uint64_t>& cells3,
+                                           const CoarseSearchConfig& c) {
+  if (picked.empty() || picked.front().second_score <= 0.0)
+    return std::nullopt;
+  Shift second = picked.front();
+  second.translation = second.second_translation;
+  second.score = second.second_score;
+  return refineIn3d(source, cells3, second, c);
+}
+
 }  // namespace
 
 std::vector<CoarseCandidate> coarseSearch(const Points& source_in, const Points& target_in,
@@ -332,6 +363,8 @@ std::vector<CoarseCandidate> coarseSearch(const Points& source_in, const Points&
             [](const CoarseCandidate& a, const CoarseCandidate& b) { return a.score > b.score; });
   if (static_cast<int>(out.size()) > c.candidates)
     out.resize(c.candidates);
+  if (const auto second = secondPlace(picked, source, cells3, c))
+    out.push_back(*second);
   return out;
 }
 

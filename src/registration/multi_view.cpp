@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "dormant_tree_modeling/common/error.h"
@@ -144,9 +145,28 @@ std::size_t chooseReference(std::vector<Station>& stations) {
               "registration: no view holds enough points (" + stations.front().reason + ")");
 }
 
+/// Why a station's placement is ambiguous (a second place, coarse.second_place_m or more from
+/// the best, fits nearly as well), or nothing.
+std::optional<std::string> ambiguity(const std::vector<IcpResult>& aligned, const IcpResult& best,
+                                     const RegistrationConfig& c) {
+  for (const auto& r : aligned) {
+    const double apart = (r.transform.translation() - best.transform.translation()).norm();
+    if (apart >= c.coarse.second_place_m && r.overlap >= c.ambiguity_overlap_share * best.overlap) {
+      std::ostringstream s;
+      s.precision(2);
+      s << std::fixed << "ambiguous: two places " << apart << " m apart fit alike (overlap "
+        << best.overlap << " and " << r.overlap
+        << "); a row of trees repeats itself: register a crop around the tree";
+      return s.str();
+    }
+  }
+  return std::nullopt;
+}
+
 /// Places a station against everything placed so far: a coarse search (around its hint,
 /// carried into the reference frame by the placed stations' hints), a few ICP levels on each
-/// candidate, and the best by overlap refined on the rest.
+/// candidate, and the best by overlap refined on the rest; left out when a second place fits
+/// nearly as well.
 void placeStation(std::vector<Station>& stations, std::size_t k, const RegistrationConfig& c) {
   Station& s = stations[k];
   const Pyramid target = othersUnion(stations, k);
@@ -164,20 +184,26 @@ void placeStation(std::vector<Station>& stations, std::size_t k, const Registrat
     s.reason = std::string("coarse search failed: ") + e.what();
     return;
   }
-  std::optional<IcpResult> best;
+  std::vector<IcpResult> aligned;
   for (const auto& cand : candidates) {
     try {
-      const IcpResult r =
-          alignPyramids(s.pyramid, target, cand.transform, c.icp, 0, c.candidate_levels - 1);
-      if (!best || r.overlap > best->overlap)
-        best = r;
+      aligned.push_back(
+          alignPyramids(s.pyramid, target, cand.transform, c.icp, 0, c.candidate_levels - 1));
     } catch (const Error&) {
       // This candidate left the clouds apart; the others may not.
     }
   }
-  if (!best) {
+  if (aligned.empty()) {
     s.rejected = true;
     s.reason = "no candidate pose overlaps the views placed before it";
+    return;
+  }
+  const auto best = std::max_element(
+      aligned.begin(), aligned.end(),
+      [](const IcpResult& a, const IcpResult& b) { return a.overlap < b.overlap; });
+  if (const auto why = ambiguity(aligned, *best, c)) {
+    s.rejected = true;
+    s.reason = *why;
     return;
   }
   try {

@@ -98,7 +98,10 @@ ConfigTable<CoarseSearchConfig> makeCoarseTable() {
       .add("z_step_m", &C::z_step_m, 0.001, 10.0, "Height step.")
       .formerly("coarse_z_step")
       .add("candidates", &C::candidates, 1, 100, "Best distinct poses returned.")
-      .formerly("coarse_candidates");
+      .formerly("coarse_candidates")
+      .add("second_place_m", &C::second_place_m, 0.01, 100.0,
+           "The best heading's second place, this far from its best at least, is tried too: a "
+           "row of trees that repeats within the window shows there.");
   return t;
 }
 
@@ -119,6 +122,11 @@ ConfigTable<RegistrationConfig> makeRegistrationTable() {
       .add("max_rmse_m", &R::max_rmse_m, 1e-4, 1.0,
            "Point-to-plane rmse above this: the station is left out.")
       .formerly("max_rmse")
+      .add("ambiguity_overlap_share", &R::ambiguity_overlap_share, 0.0, 1.0,
+           "A candidate ending coarse.second_place_m or more from the best and fitting with this "
+           "share of its overlap, or more: the "
+           "station is left out as ambiguous (a row that repeats within the search window). "
+           "1 keeps only exact ties out.")
       .add("use_hints", &R::use_hints, "False: ignore the platform hints (global search).")
       .retired({"beam_exit", "beam_divergence", "silhouette_fraction"},
                "the silhouette growth comes from the sensor calibration file "

@@ -239,6 +239,51 @@ TEST_F(MultiView, LeavesOutAViewOfAnotherTreeAndAViewOfNothing) {
   EXPECT_EQ(mergeRegistered(views, r).size(), views[0].points.size() + views[1].points.size());
 }
 
+// A row of copies of the target tree (in the world frame), one every `spacing_m` along x.
+Points rowOfCopies(const Points& tree_world, int copies, double spacing_m) {
+  Points row;
+  for (int k = -copies / 2; k <= copies / 2; ++k) {
+    for (const auto& p : tree_world)
+      row.push_back(p + Eigen::Vector3d(k * spacing_m, 0.0, 0.0));
+  }
+  return row;
+}
+
+TEST_F(MultiView, LeavesOutAStationThatARepeatingRowPlacesTwice) {
+  // Two stations one tree apart along a row of identical trees: the second overlays the first
+  // shifted by one tree better than in its true place (all three of its trees on the first's,
+  // against two). Its hint is 0.3 m off, as odometry is.
+  const double spacing = 1.0;
+  Points tree_world;
+  for (const auto& p : viewOfTree(*model_, FRONT_LEFT, 0, 0, 0.45))
+    tree_world.push_back(FRONT_LEFT * p);
+  // Each station sees the trees within 1.6 m of it along the row (three of the row's five).
+  const auto viewFrom = [&](const Points& world, const Eigen::Isometry3d& platform, int id) {
+    ViewInput v;
+    v.name = "view_" + std::to_string(id);
+    v.station = id;
+    for (const auto& p : world) {
+      if (std::abs(p.x() - platform.translation().x()) <= 1.6)
+        v.points.push_back(platform.inverse() * p);
+    }
+    v.station_hint = platform * geometry::platformPose(0.3, 0.0, 0.0, 0.0);
+    return v;
+  };
+  const Eigen::Isometry3d next = Eigen::Translation3d(spacing, 0, 0) * FRONT_LEFT;
+  const Points row = rowOfCopies(tree_world, 5, spacing);
+  const RegistrationResult repeated =
+      registerViews({viewFrom(row, FRONT_LEFT, 0), viewFrom(row, next, 1)},
+                    test::sensorModelRegistrationConfig());
+  EXPECT_FALSE(repeated.views[1].registered);
+  EXPECT_NE(repeated.views[1].reason.find("ambiguous"), std::string::npos)
+      << repeated.views[1].reason;
+  // The same two stations before a single tree: one place fits, and the station is kept.
+  const RegistrationResult single =
+      registerViews({viewFrom(tree_world, FRONT_LEFT, 0), viewFrom(tree_world, next, 1)},
+                    test::sensorModelRegistrationConfig());
+  EXPECT_TRUE(single.views[1].registered) << single.views[1].reason;
+}
+
 TEST(Registration, RejectsBadInputWithClearErrors) {
   EXPECT_THROW(registerViews({}, {}), Error);
   RegistrationConfig bad;

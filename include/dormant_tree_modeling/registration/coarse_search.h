@@ -23,6 +23,9 @@ struct CoarseSearchConfig {
   double z_window_unhinted_m = 2.0;
   double z_step_m = 0.05;
   int candidates = 3;  ///< best distinct poses returned
+  /// The best heading's second place is also returned: its best shift at least this far from
+  /// its best one. A row of trees repeating within the window shows there as a second peak.
+  double second_place_m = 0.25;
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
 };
@@ -37,7 +40,8 @@ struct CoarseCandidate {
 /// shift that best overlays the two top-down footprints (the tree's trunk and branches), then
 /// the height that best overlays the 3-D cells.
 /// @param hint initial source -> target guess, or none (full search)
-/// @returns up to config.candidates poses, best first
+/// @returns up to config.candidates poses, best first, then the best heading's second place
+/// (CoarseSearchConfig::second_place_m) when its footprints overlap at all
 /// @throws Error EMPTY_INPUT when either set is empty
 std::vector<CoarseCandidate> coarseSearch(const Points& source, const Points& target,
                                           const std::optional<Eigen::Isometry3d>& hint,

@@ -31,6 +31,11 @@ struct RegistrationConfig {
   /// does not pass.
   double min_overlap = 0.4;
   double max_rmse_m = 0.012;
+  /// A station whose coarse candidates (its second place among them) end, after their ICP
+  /// levels, in two places coarse.second_place_m or more apart, the second fitting with at
+  /// least this share of the best one's overlap, is left out as ambiguous: a row of trees
+  /// about as far apart as the search window is wide overlays itself shifted by one tree.
+  double ambiguity_overlap_share = 0.5;
   bool use_hints = true;  ///< false: ignore the guesses (global search from scratch)
   /// @throws Error INVALID_ARGUMENT naming the bad field
   void validate() const;
