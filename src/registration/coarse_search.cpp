@@ -100,13 +100,6 @@ constexpr int HEADINGS_PER_CANDIDATE = 3;
 // The 3-D step tries the horizontal neighbours half a cell away.
 constexpr double REFINE_XY_SHARE = 0.5;
 
-Eigen::Vector3d mean(const Points& pts) {
-  Eigen::Vector3d m = Eigen::Vector3d::Zero();
-  for (const auto& p : pts)
-    m += p;
-  return m / static_cast<double>(pts.size());
-}
-
 // The target's cells dilated by one (noise, cell edges).
 std::unordered_set<std::uint64_t> dilatedCells(const Points& target, double cell) {
   std::unordered_set<std::uint64_t> cells3;
@@ -345,7 +338,7 @@ std::vector<CoarseCandidate> coarseSearch(const Points& source_in, const Points&
     throw Error(ErrorCode::EMPTY_INPUT, "coarse search: a cloud is empty");
   const Columns grid = columns(target, c.cell_m, 2 * c.cell_m);
   const std::unordered_set<std::uint64_t> cells3 = dilatedCells(target, c.cell_m);
-  const Placement placement{hint, mean(source), mean(target)};
+  const Placement placement{hint, centroid(source), centroid(target)};
   const std::vector<double> yaws = headingsToTry(hint, c);
   const std::vector<int> dzs = heightShifts(source, target, grid, placement, c);
 

@@ -146,17 +146,18 @@ std::size_t chooseReference(std::vector<Station>& stations) {
 }
 
 /// Why a station's placement is ambiguous (a second place, coarse.second_place_m or more from
-/// the best, fits nearly as well), or nothing.
+/// the best, fits nearly as well), or nothing. Places are compared where they put the
+/// station's centre: two headings alone move a pose's translation, not its points.
 std::optional<std::string> ambiguity(const std::vector<IcpResult>& aligned, const IcpResult& best,
-                                     const RegistrationConfig& c) {
+                                     const Eigen::Vector3d& centre, const RegistrationConfig& c) {
   for (const auto& r : aligned) {
-    const double apart = (r.transform.translation() - best.transform.translation()).norm();
+    const double apart = (r.transform * centre - best.transform * centre).norm();
     if (apart >= c.coarse.second_place_m && r.overlap >= c.ambiguity_overlap_share * best.overlap) {
       std::ostringstream s;
       s.precision(2);
       s << std::fixed << "ambiguous: two places " << apart << " m apart fit alike (overlap "
         << best.overlap << " and " << r.overlap
-        << "); a row of trees repeats itself: register a crop around the tree";
+        << "), as along a row of evenly spaced trees: register a crop around the tree";
       return s.str();
     }
   }
@@ -201,7 +202,7 @@ void placeStation(std::vector<Station>& stations, std::size_t k, const Registrat
   const auto best = std::max_element(
       aligned.begin(), aligned.end(),
       [](const IcpResult& a, const IcpResult& b) { return a.overlap < b.overlap; });
-  if (const auto why = ambiguity(aligned, *best, c)) {
+  if (const auto why = ambiguity(aligned, *best, centroid(s.pyramid.levels.front().points), c)) {
     s.rejected = true;
     s.reason = *why;
     return;

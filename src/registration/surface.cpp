@@ -30,6 +30,13 @@ struct VoxelHash {
 
 }  // namespace
 
+Eigen::Vector3d centroid(const Points& pts) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : pts)
+    c += p;
+  return pts.empty() ? c : Eigen::Vector3d(c / static_cast<double>(pts.size()));
+}
+
 Points viewDirections(const Points& pts, const Eigen::Vector3d& sensor) {
   Points d(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) {

@@ -25,6 +25,9 @@ struct Surface {
   std::size_t size() const { return points.size(); }
 };
 
+/// @brief The mean of the points (zero for none).
+Eigen::Vector3d centroid(const Points& pts);
+
 /// @brief View directions of points seen from one sensor position (same frame).
 Points viewDirections(const Points& pts, const Eigen::Vector3d& sensor);
 
