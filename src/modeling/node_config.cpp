@@ -15,7 +15,9 @@ ConfigTable<TreeModelerNodeConfig> makeTable() {
       .add("calibration_file", &N::calibration_file,
            "Sensor calibration (calibrate_diameters); empty: diameters corrected for range "
            "noise only (warned).")
-      .add("output_dir", &N::output_dir, "model.json and cylinders.csv of each model; empty: none.")
+      .add("output_dir", &N::output_dir,
+           "model.json, cylinders.csv, turned_down.csv and cloud.pcd/.ply of each model; empty: "
+           "none.")
       .add("output_frame", &N::output_frame,
            "Cylinders and segments published in this frame; empty: the cloud's.")
       .add("exit_after_models", &N::exit_after_models, 0, 1000000,

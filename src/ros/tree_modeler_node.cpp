@@ -182,7 +182,7 @@ std::string TreeModelerNode::process(const sensor_msgs::PointCloud2& msg) {
     warnOnce(result.model.correction.warnings);
     const std::string summary = publish(result, msg.header);
     if (!output_dir_.empty())
-      writeFiles(result.model, *cloud, msg.header);
+      writeFiles(result, *cloud, msg.header);
     noteOutcome(true, summary);
     return summary;
   } catch (const Error& e) {
@@ -217,8 +217,9 @@ std::string TreeModelerNode::publish(const modeling::ModelResult& result,
   return s.str();
 }
 
-void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const Cloud& cloud,
+void TreeModelerNode::writeFiles(const modeling::ModelResult& result, const Cloud& cloud,
                                  const std_msgs::Header& header) {
+  const modeling::TreeModel& model = result.model;
   modeling::TreeModel out = model;
   Eigen::Isometry3d to_output = Eigen::Isometry3d::Identity();
   if (!output_frame_.empty() && output_frame_ != header.frame_id) {
@@ -234,6 +235,10 @@ void TreeModelerNode::writeFiles(const modeling::TreeModel& model, const Cloud& 
   }
   io::writeTextFile(output_dir_ + "/model.json", io::modelToJson(out));
   io::writeTextFile(output_dir_ + "/cylinders.csv", io::cylindersToCsv(out));
+  std::vector<modeling::RejectedBranch> turned_down = result.rejected_branches;
+  for (auto& r : turned_down)
+    r.centroid = to_output * r.centroid;
+  io::writeTextFile(output_dir_ + "/turned_down.csv", io::turnedDownToCsv(turned_down));
   // The cloud beside the model, in the same frame, for pictures and for checking the fit.
   Cloud moved;
   pcl::transformPointCloud(cloud, moved, to_output.cast<float>().matrix());

@@ -15,6 +15,7 @@
 #include <ros/ros.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 
@@ -57,6 +58,7 @@ TEST(EndToEnd, VirtualPlatformToTreeModelMatchesTheTruth) {
   const std::string truth_path = g_output_dir + "/truth/truth.json";
   // A model of an earlier run would pass for this one's (the modeler writes it minutes later).
   std::filesystem::remove(model_path);
+  std::filesystem::remove(g_output_dir + "/model/turned_down.csv");
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(g_time_limit);
   while (ros::WallTime::now() < give_up && !std::filesystem::exists(model_path))
     ros::WallDuration(1.0).sleep();
@@ -69,6 +71,12 @@ TEST(EndToEnd, VirtualPlatformToTreeModelMatchesTheTruth) {
     EXPECT_EQ(model_msg->header.frame_id, "tree");
     EXPECT_FALSE(model_msg->trunk.empty());
   }
+
+  // Beside the model: the candidates the branch search turned down, where and why.
+  std::ifstream turned_down(g_output_dir + "/model/turned_down.csv");
+  std::string header;
+  std::getline(turned_down, header);
+  EXPECT_EQ(header, "centroid_x,centroid_y,centroid_z,points,reason,budget_spent");
 
   const modeling::TreeModel model = io::readModelFile(model_path);
   const evaluation::GroundTruth truth = io::readTruthFile(truth_path);

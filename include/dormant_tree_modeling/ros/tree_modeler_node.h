@@ -61,7 +61,7 @@ class TreeModelerNode {
   std::string process(const sensor_msgs::PointCloud2& msg);
   /// Publishes the model, markers and segments (and writes the files); returns a summary.
   std::string publish(const modeling::ModelResult& result, const std_msgs::Header& header);
-  void writeFiles(const modeling::TreeModel& model, const Cloud& cloud,
+  void writeFiles(const modeling::ModelResult& result, const Cloud& cloud,
                   const std_msgs::Header& header);
   void noteOutcome(bool ok, const std::string& message);
   /// Logs each calibration warning of the models the first time it comes.
