@@ -111,35 +111,76 @@ ViewFolder readViewFolder(const std::string& dir, const ViewFolderConfig& option
   return f;
 }
 
-PoseErrors poseErrors(const RegistrationResult& result,
-                      const std::vector<std::optional<Eigen::Isometry3d>>& true_poses) {
-  PoseErrors e;
-  int first = -1;
-  for (std::size_t i = 0; i < result.views.size() && first < 0; ++i) {
-    if (result.views[i].registered && i < true_poses.size() && true_poses[i])
-      first = static_cast<int>(i);
-  }
-  if (first < 0)
-    return e;
-  // The result's frame is the first registered view's; so is the truth, once made relative.
-  const Eigen::Isometry3d world_to_first = true_poses[first]->inverse();
-  const Eigen::Isometry3d result_first_inv = result.views[first].pose.inverse();
+namespace {
+
+/// The errors of `got` against `truth`, view by view, both in one frame.
+PoseErrorFigures poseErrorFigures(const std::vector<Eigen::Isometry3d>& truth,
+                                  const std::vector<Eigen::Isometry3d>& got) {
   std::vector<double> dt, da;
-  for (std::size_t i = 0; i < result.views.size(); ++i) {
-    if (!result.views[i].registered || i >= true_poses.size() || !true_poses[i])
-      continue;
-    const Eigen::Isometry3d truth = world_to_first * *true_poses[i];
-    const Eigen::Isometry3d got = result_first_inv * result.views[i].pose;
-    const Eigen::Isometry3d d = truth.inverse() * got;
-    dt.push_back((got.translation() - truth.translation()).norm() * 1000);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const Eigen::Isometry3d d = truth[i].inverse() * got[i];
+    dt.push_back((got[i].translation() - truth[i].translation()).norm() * 1000);
     da.push_back(Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
   }
-  e.views = static_cast<int>(dt.size());
+  PoseErrorFigures e;
   e.median_mm = median(dt);
   e.median_deg = median(da);
   e.max_mm = *std::max_element(dt.begin(), dt.end());
   e.max_deg = *std::max_element(da.begin(), da.end());
   return e;
+}
+
+/// The rigid transform taking `got`'s frame onto `truth`'s that best fits each view's origin
+/// and the 1 m tips of its axes (least squares, Umeyama without scale).
+Eigen::Isometry3d bestAlignment(const std::vector<Eigen::Isometry3d>& truth,
+                                const std::vector<Eigen::Isometry3d>& got) {
+  constexpr int POINTS_PER_VIEW = 4;
+  Eigen::Matrix3Xd from(3, POINTS_PER_VIEW * got.size()), to(3, POINTS_PER_VIEW * got.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    for (int k = 0; k < POINTS_PER_VIEW; ++k) {
+      const Eigen::Vector3d local = k == 0 ? Eigen::Vector3d(Eigen::Vector3d::Zero())
+                                           : Eigen::Vector3d(Eigen::Vector3d::Unit(k - 1));
+      from.col(POINTS_PER_VIEW * i + k) = got[i] * local;
+      to.col(POINTS_PER_VIEW * i + k) = truth[i] * local;
+    }
+  }
+  return Eigen::Isometry3d(Eigen::umeyama(from, to, false));
+}
+
+}  // namespace
+
+PoseErrors poseErrors(const RegistrationResult& result,
+                      const std::vector<std::optional<Eigen::Isometry3d>>& true_poses) {
+  PoseErrors e;
+  std::vector<Eigen::Isometry3d> truth, got;
+  for (std::size_t i = 0; i < result.views.size() && i < true_poses.size(); ++i) {
+    if (result.views[i].registered && true_poses[i]) {
+      truth.push_back(*true_poses[i]);
+      got.push_back(result.views[i].pose);
+    }
+  }
+  if (truth.empty())
+    return e;
+  e.views = static_cast<int>(truth.size());
+  // The result's frame is the first registered view's: carried onto the truth by that view.
+  const Eigen::Isometry3d first = truth.front() * got.front().inverse();
+  std::vector<Eigen::Isometry3d> in_truth;
+  for (const auto& g : got)
+    in_truth.push_back(first * g);
+  e.first_view = poseErrorFigures(truth, in_truth);
+  const Eigen::Isometry3d best = bestAlignment(truth, got);
+  for (std::size_t i = 0; i < got.size(); ++i)
+    in_truth[i] = best * got[i];
+  e.aligned = poseErrorFigures(truth, in_truth);
+  return e;
+}
+
+std::string poseErrorText(const PoseErrorFigures& e) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(1) << "median " << e.median_mm << " mm / "
+    << std::setprecision(3) << e.median_deg << " deg, max " << std::setprecision(1) << e.max_mm
+    << " mm / " << std::setprecision(3) << e.max_deg << " deg";
+  return s.str();
 }
 
 const char* endName(RegistrationInput::End end) {
@@ -203,10 +244,10 @@ std::string registrationReport(const RegistrationResult& r,
     << " s, joint refinement " << r.seconds_refinement
     << " s), into the frame of the first view.\n\n";
   if (errors && errors->views > 0) {
-    s << "Against the true poses (" << errors->views << " views): " << std::setprecision(1)
-      << "median " << errors->median_mm << " mm / " << std::setprecision(3) << errors->median_deg
-      << " deg, max " << std::setprecision(1) << errors->max_mm << " mm / " << std::setprecision(3)
-      << errors->max_deg << " deg.\n\n";
+    s << "Against the true poses (" << errors->views
+      << " views): " << poseErrorText(errors->first_view) << " in the first view's frame; "
+      << poseErrorText(errors->aligned)
+      << " with all poses aligned to the truth at once (the registered cloud's shape).\n\n";
   }
   s << "| view | station | registered | x m | y m | z m | yaw deg | rmse mm | overlap | "
        "confidence | note |\n|---|---|---|---|---|---|---|---|---|---|---|\n";

@@ -84,11 +84,11 @@ int main(int argc, char** argv) {
     std::cout << std::fixed << std::setprecision(1) << result.views.size() - left_out << " of "
               << result.views.size() << " views registered in " << result.seconds << " s; "
               << points << " points -> " << out << "\n";
-    if (errors)
-      std::cout << "pose error vs truth: median " << errors->median_mm << " mm / "
-                << std::setprecision(3) << errors->median_deg << " deg, max "
-                << std::setprecision(1) << errors->max_mm << " mm / " << std::setprecision(3)
-                << errors->max_deg << " deg\n";
+    if (errors) {
+      std::cout << "pose error vs truth: " << registration::poseErrorText(errors->first_view)
+                << " in the first view's frame; " << registration::poseErrorText(errors->aligned)
+                << " aligned\n";
+    }
     return left_out == 0 ? 0 : 1;
   } catch (const po::error& e) {
     std::cerr << "register_views: " << e.what() << "\n" << desc << "\n";

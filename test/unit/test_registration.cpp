@@ -429,6 +429,47 @@ Eigen::Isometry3d hintAt(double x, double yaw_rad) {
   return Eigen::Translation3d(x, -1.5, 1.5) * Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ());
 }
 
+// Five views in a cross; the first is registered 10 mm off the four others' consensus, so in
+// its frame each of them reads 10 mm off. Aligned at once, the error is spread as least
+// squares spread it: the first 8 mm off, the others 2 mm.
+TEST(PoseErrors, TheFirstViewsOwnErrorShowsInEveryViewButNotInTheAlignedShape) {
+  const Eigen::Isometry3d world =
+      Eigen::Translation3d(3.0, -1.5, 1.2) * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ());
+  const std::vector<Eigen::Vector3d> at = {{0, 0, 0}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+  const Eigen::Vector3d first_off(0.01, 0.0, 0.0);
+  std::vector<std::optional<Eigen::Isometry3d>> truth;
+  RegistrationResult exact, shifted;
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    truth.emplace_back(world * Eigen::Translation3d(at[i]));
+    ViewResult v;
+    v.registered = true;
+    v.pose = Eigen::Translation3d(at[i]) * Eigen::Isometry3d::Identity();
+    exact.views.push_back(v);
+    v.pose = i == 0 ? Eigen::Isometry3d::Identity()
+                    : Eigen::Isometry3d(Eigen::Translation3d(at[i] - first_off));
+    shifted.views.push_back(v);
+  }
+  const PoseErrors none = poseErrors(exact, truth);
+  EXPECT_EQ(none.views, 5);
+  EXPECT_NEAR(none.first_view.max_mm, 0.0, 1e-9);
+  EXPECT_NEAR(none.aligned.max_mm, 0.0, 1e-6);
+  EXPECT_NEAR(none.aligned.max_deg, 0.0, 1e-6);
+
+  const PoseErrors e = poseErrors(shifted, truth);
+  EXPECT_NEAR(e.first_view.median_mm, 10.0, 1e-9);
+  EXPECT_NEAR(e.first_view.max_mm, 10.0, 1e-9);
+  EXPECT_NEAR(e.first_view.max_deg, 0.0, 1e-9);
+  EXPECT_NEAR(e.aligned.median_mm, 2.0, 1e-6);
+  EXPECT_NEAR(e.aligned.max_mm, 8.0, 1e-6);
+  EXPECT_NEAR(e.aligned.max_deg, 0.0, 1e-4);
+  EXPECT_EQ(poseErrorText(e.first_view), "median 10.0 mm / 0.000 deg, max 10.0 mm / 0.000 deg");
+
+  // A view left out counts in neither; no view with a true pose: no figures.
+  shifted.views[0].registered = false;
+  EXPECT_EQ(poseErrors(shifted, truth).views, 4);
+  EXPECT_EQ(poseErrors(shifted, {}).views, 0);
+}
+
 TEST(StationGrouper, ViewsWithTheSameHintShareAStationAndAMoveStartsTheNext) {
   StationGrouper g;
   EXPECT_EQ(g.next(hintAt(0.0, 0.0)), 1);

@@ -49,15 +49,31 @@ constexpr std::size_t FEW_VIEW_POINTS = 100;
 /// @throws Error FILE_NOT_FOUND, PARSE_ERROR naming the file
 ViewFolder readViewFolder(const std::string& dir, const ViewFolderConfig& options = {});
 
-/// @brief Pose errors of the registered views against the truth, relative to the first view.
-struct PoseErrors {
-  int views = 0;  ///< registered views with a true pose
+/// @brief How far registered views sit from their true poses: the median and largest
+/// translation (mm) and rotation (deg) errors over the views.
+struct PoseErrorFigures {
   double median_mm = 0, max_mm = 0, median_deg = 0, max_deg = 0;
 };
 
-/// @brief Compare registered poses with true ones (both taken relative to the first view).
+/// @brief Pose errors of the registered views against the truth, read two ways.
+struct PoseErrors {
+  int views = 0;  ///< registered views with a true pose
+  /// In the result's frame, the first registered view's: every view carries that view's own
+  /// error as well as its own.
+  PoseErrorFigures first_view;
+  /// After the rigid transform that best aligns all registered poses with the true ones (a
+  /// least-squares fit of each view's origin and its axes' 1 m tips): the registered cloud's
+  /// own shape, whichever view's error the frame carries.
+  PoseErrorFigures aligned;
+};
+
+/// @brief Compare registered poses with true ones (PoseErrors). Nothing (views 0) when no
+/// registered view has a true pose.
 PoseErrors poseErrors(const RegistrationResult& result,
                       const std::vector<std::optional<Eigen::Isometry3d>>& true_poses);
+
+/// @brief The pose errors as one line of text: "median a mm / b deg, max c mm / d deg".
+std::string poseErrorText(const PoseErrorFigures& e);
 
 /// @brief How a registration's views came in, when a node collected them from a live or
 /// replayed acquisition: what started the registration and whether every planned view was there.
