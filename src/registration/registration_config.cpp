@@ -124,9 +124,8 @@ ConfigTable<RegistrationConfig> makeRegistrationTable() {
       .formerly("max_rmse")
       .add("ambiguity_overlap_share", &R::ambiguity_overlap_share, 0.0, 1.0,
            "A candidate ending coarse.second_place_m or more from the best and fitting with this "
-           "share of its overlap, or more: the "
-           "station is left out as ambiguous (a row that repeats within the search window). "
-           "1 keeps only exact ties out.")
+           "share of its overlap, or more: the station is left out as ambiguous (a row that "
+           "repeats within the search window). 1 keeps only exact ties out.")
       .add("use_hints", &R::use_hints, "False: ignore the platform hints (global search).")
       .retired({"beam_exit", "beam_divergence", "silhouette_fraction"},
                "the silhouette growth comes from the sensor calibration file "
