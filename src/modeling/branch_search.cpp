@@ -53,10 +53,15 @@ constexpr double RAY_TUBE_RADIUS = 0.01;  // m
 constexpr double CUT_WALK_REACH = 1.0;  // m, beyond any fit's way back
 constexpr double CUT_FILL_SHARE = 0.2;
 constexpr int CUT_FILL_MIN_POINTS = 3;
+// A cut-off piece's near part may hold what a crossing branch's extraction left of it (the
+// crossing branch's own returns beside it): its fit then turns from the branch by 5-10 deg.
+// The line through the whole piece replaces it when it turns by no more than this.
+constexpr double CUT_REFIT_MAX_TURN = 15.0 * DEG;
 // Seeds: per candidate, from the modeler's seed and a running stream.
 constexpr std::uint64_t HALVES_SEED_FACTOR = 7757ULL;
 constexpr std::uint64_t FIT_SEED_FACTOR = 15485863ULL;
-constexpr std::uint64_t REFIT_STREAM_START = 1ULL << 32;  // past any tree's fits
+constexpr std::uint64_t REFIT_STREAM_START = 1ULL << 32;      // past any tree's fits
+constexpr std::uint64_t CUT_REFIT_STREAM_START = 2ULL << 32;  // past any tree's refits
 // A primary's axis passes through its trunk: a fit whose axis passes more than FORK_AXIS_GAP
 // outside the trunk surface followed a side arm forking off the branch (a secondary, a shoot at
 // its tip), which leaves the branch at an angle. 96 % of matched primaries pass within it,
@@ -84,6 +89,11 @@ constexpr double WIRE_FAR_FROM = 0.05;            // m past the trunk surface
 constexpr double WIRE_FAR_TO = 0.4;               // m past the trunk surface
 constexpr double WIRE_TOLERANCE = 0.008;          // m plus the noise, around each step
 constexpr double WIRE_OCCUPIED_SHARE = 0.8;       // of the steps that hold a return
+
+/// The widest branch a constrained fit takes: no wider than its trunk segment.
+double maxBranchRadius(const Cylinder& seg) {
+  return std::max(MIN_BRANCH_RADIUS_M * 2, seg.radius);
+}
 
 double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
@@ -301,6 +311,9 @@ void BranchSearch::examine(const Candidate& candidate) {
     return reject(candidate, near.segment, {BranchRejection::NO_FIT, true});
   if (config.fit.constrain && missesLikeASideArm(*cyl, seg))
     refitAtFork(candidate, seg, *guess, &near, &*cyl, &inliers, &wood_radius);
+  const bool cut_off = !reachesSurface(near);
+  if (config.fit.constrain && config.branches.keep_cut_off && cut_off)
+    refitCutOff(candidate, seg, near, &*cyl);
   Eigen::Vector3d attachment;
   const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
   bool reaches_surface = true;
@@ -309,13 +322,10 @@ void BranchSearch::examine(const Candidate& candidate) {
       return reject(candidate, near.segment, *verdict);
     if (spansTheTrunk(*cyl, seg, near, inliers))
       return reject(candidate, near.segment, {BranchRejection::SPANS_THE_TRUNK, true});
-    reaches_surface = reachesSurface(near);
+    reaches_surface = !cut_off;
     // A branch crossing this one near the trunk may have taken its near part out with it;
     // its way back then leads into the trunk, which a side arm's does not.
-    if (!reaches_surface &&
-        !(config.branches.keep_cut_off && !missesLikeASideArm(*cyl, seg) &&
-          filledToSurface(*cyl, seg, context_.index, context_.bands.inner_gap, near.nearest_gap,
-                          cyl->radius + context_.bands.threshold)))
+    if (cut_off && !(config.branches.keep_cut_off && leadsBack(*cyl, seg, near)))
       return reject(candidate, near.segment, {BranchRejection::NOT_AT_THE_SURFACE, true});
     if (auto verdict = checkPlace(candidate, *cyl, attachment))
       return reject(candidate, near.segment, *verdict);
@@ -331,6 +341,39 @@ void BranchSearch::examine(const Candidate& candidate) {
     return;
   }
   accept(candidate, near, *cyl, wood_radius, inliers, attachment, reaches_surface);
+}
+
+/// Whether a cut-off fit's way back leads into the trunk (not past it as a side arm's does) with
+/// returns all along it (filledToSurface).
+bool BranchSearch::leadsBack(const Cylinder& fit, const Cylinder& seg, const NearPart& near) const {
+  return !missesLikeASideArm(fit, seg) &&
+         filledToSurface(fit, seg, context_.index, context_.bands.inner_gap, near.nearest_gap,
+                         fit.radius + context_.bands.threshold);
+}
+
+/// A branch crossing another near the trunk cuts it in two by its extraction, and the outer
+/// piece's near part may keep returns of the crossing branch at its inner end. Its fit then turns
+/// from the branch: it misses the trunk like a side arm's, or its way back leaves the branch's
+/// returns. The line through the whole piece (a thin-cylinder fit to all its points, which a few
+/// of the crossing branch's returns do not turn) is the branch's: when the near part's fit does
+/// not lead back into the trunk and that line, within CUT_REFIT_MAX_TURN of it, does, the line
+/// replaces its axis. The radius stays the near part's.
+void BranchSearch::refitCutOff(const Candidate& candidate, const Cylinder& seg,
+                               const NearPart& near, Cylinder* cyl) {
+  if (leadsBack(*cyl, seg, near))
+    return;
+  Points piece;
+  for (const int k : candidate.members)
+    piece.push_back(candidates_.pts[k]);
+  const auto whole = fitThinCylinder(piece, cyl->axis, context_.bands.sigma, 0.0,
+                                     maxBranchRadius(seg), nextCutRefitSeed());
+  if (!whole)
+    return;
+  Cylinder line = *cyl;
+  line.axis = whole->axis.dot(cyl->axis) < 0.0 ? -whole->axis : whole->axis;
+  line.center = whole->center + (cyl->center - whole->center).dot(line.axis) * line.axis;
+  if (lineAngle(line.axis, cyl->axis) <= CUT_REFIT_MAX_TURN && leadsBack(line, seg, near))
+    *cyl = line;
 }
 
 /// A fit along a side arm forking off a branch (missesLikeASideArm) is replaced by a fit along
@@ -410,6 +453,9 @@ std::uint64_t BranchSearch::nextFitSeed() {
 std::uint64_t BranchSearch::nextRefitSeed() {
   return context_.config.seed * FIT_SEED_FACTOR + REFIT_STREAM_START + refit_stream_++;
 }
+std::uint64_t BranchSearch::nextCutRefitSeed() {
+  return context_.config.seed * FIT_SEED_FACTOR + CUT_REFIT_STREAM_START + cut_refit_stream_++;
+}
 
 BranchSearch::NearPart BranchSearch::nearPart(const std::vector<int>& cluster, double reach) const {
   NearPart near;
@@ -472,8 +518,7 @@ std::optional<Cylinder> BranchSearch::fit(const NearPart& near, const Cylinder& 
   o.axis_candidates = AXIS_CANDIDATES;
   o.max_axis_deviation = config.fit.constrain ? MAX_AXIS_DEVIATION : PAPER_MAX_AXIS_DEVIATION;
   o.min_radius = MIN_BRANCH_RADIUS_M;
-  o.max_radius = config.fit.constrain ? std::max(MIN_BRANCH_RADIUS_M * 2, seg.radius)
-                                      : PAPER_MAX_BRANCH_RADIUS;
+  o.max_radius = config.fit.constrain ? maxBranchRadius(seg) : PAPER_MAX_BRANCH_RADIUS;
   o.seed = seed;
   if (!config.fit.constrain) {
     auto cyl = ransacCylinder(near.pts, guess.axis, o, inliers);

@@ -123,6 +123,9 @@ class BranchSearch {
   void reportTurnedDown(std::size_t steep_from);
   void examine(const Candidate& candidate);
   NearPart nearPart(const std::vector<int>& cluster, double reach) const;
+  bool leadsBack(const Cylinder& fit, const Cylinder& seg, const NearPart& near) const;
+  void refitCutOff(const Candidate& candidate, const Cylinder& seg, const NearPart& near,
+                   Cylinder* cyl);
   bool refitAtFork(const Candidate& candidate, const Cylinder& seg, const Direction& guess,
                    NearPart* near, Cylinder* cyl, std::vector<int>* inliers, double* wood_radius);
   std::optional<Cylinder> baseFit(const Candidate& candidate, const Cylinder& seg,
@@ -137,6 +140,7 @@ class BranchSearch {
                                      std::vector<int>* inliers, double* wood_radius);
   std::uint64_t nextFitSeed();
   std::uint64_t nextRefitSeed();
+  std::uint64_t nextCutRefitSeed();
   std::optional<Verdict> checkDirection(const Candidate& candidate, const Cylinder& fit,
                                         const Cylinder& seg, const Direction& guess,
                                         double gap) const;
@@ -166,6 +170,8 @@ class BranchSearch {
   std::uint64_t stream_ = 0;  // of random seeds, one per k-means split and per fit
   // Of the refits at forks, apart: a refit leaves every other fit's seed as it was.
   std::uint64_t refit_stream_ = 0;
+  // Of the cut-off pieces' refits along their whole length, apart for the same reason.
+  std::uint64_t cut_refit_stream_ = 0;
   std::vector<BranchFit> branches_;
   std::vector<CutFit> cut_;
   std::vector<TurnedDown> turned_down_;
