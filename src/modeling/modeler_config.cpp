@@ -179,7 +179,8 @@ void addBranchSearch(ConfigTable<ModelerConfig>& t) {
       .formerly("branch_ray_split_min_noise")
       .add("branches.keep_cut_off", &B::keep_cut_off,
            "A fit cut off from the trunk by a crossing branch's extraction is kept when returns "
-           "fill its way back and its axis leads into the trunk.")
+           "fill its way back and its axis leads into the trunk (or, when the crossing branch's "
+           "returns turned the fit, the line through the whole cut-off piece does).")
       .formerly("branch_keep_cut_off")
       .add("branches.merge_curved", &B::merge_curved,
            "Two pieces of one curved branch (one centre inside the other's tube, axes within "
