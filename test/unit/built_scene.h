@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <random>
 #include <vector>
 
 #include "dormant_tree_modeling/modeling/modeler_config.h"
@@ -30,6 +31,14 @@ inline void addCylinder(Points& pts, const Eigen::Vector3d& base, const Eigen::V
       pts.push_back(base + i * step * a + r * (std::cos(phi) * u + std::sin(phi) * v));
     }
   }
+}
+
+/// Every point moved by isotropic Gaussian noise of `sigma` (m), seeded.
+inline void addIsotropicNoise(Points& pts, double sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  for (auto& p : pts)
+    p += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
 }
 
 /// The angle between two lines (undirected), in degrees.

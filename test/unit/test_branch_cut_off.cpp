@@ -4,7 +4,6 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -17,6 +16,7 @@ namespace modeling {
 namespace {
 
 using test::addCylinder;
+using test::addIsotropicNoise;
 using test::buildTrunk;
 using test::lineAngleDeg;
 
@@ -77,10 +77,7 @@ Points crossingScene(double sigma_m, unsigned seed, std::size_t* trunk_points) {
   *trunk_points = pts.size();
   addCylinder(pts, {0.03, 0, 1.12}, LEVEL, 0.0066, 0.6);
   addCylinder(pts, 0.03 * AROUND + Eigen::Vector3d(0, 0, 0.98), RISING, 0.009, 0.6);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, sigma_m);
-  for (auto& p : pts)
-    p += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+  addIsotropicNoise(pts, sigma_m, seed);
   return pts;
 }
 

@@ -5,7 +5,6 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <random>
 #include <vector>
 
 #include "built_scene.h"
@@ -17,6 +16,7 @@ namespace modeling {
 namespace {
 
 using test::addCylinder;
+using test::addIsotropicNoise;
 using test::buildTrunk;
 using test::lineAngleDeg;
 
@@ -67,10 +67,7 @@ Points noisyThinFork(double fork_off_m, double primary_length_m, double sigma_m,
   const Eigen::Vector3d arm =
       Eigen::Vector3d(std::cos(56.0 * DEG), std::sin(56.0 * DEG), 0.3).normalized();
   addCylinder(pts, SURFACE + fork_off_m * OUT, arm, 0.002, 0.20);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, sigma_m);
-  for (auto& p : pts)
-    p += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+  addIsotropicNoise(pts, sigma_m, seed);
   return pts;
 }
 
