@@ -312,8 +312,8 @@ void BranchSearch::examine(const Candidate& candidate) {
   if (config.fit.constrain && missesLikeASideArm(*cyl, seg))
     refitAtFork(candidate, seg, *guess, &near, &*cyl, &inliers, &wood_radius);
   const bool cut_off = !reachesSurface(near);
-  if (config.fit.constrain && config.branches.keep_cut_off && cut_off)
-    refitCutOff(candidate, seg, near, &*cyl);
+  const bool leads_back = config.fit.constrain && config.branches.keep_cut_off && cut_off &&
+                          refitCutOff(candidate, seg, near, &*cyl);
   Eigen::Vector3d attachment;
   const double gap = lineGap(cyl->center, cyl->axis, seg.center, seg.axis, &attachment);
   bool reaches_surface = true;
@@ -325,7 +325,7 @@ void BranchSearch::examine(const Candidate& candidate) {
     reaches_surface = !cut_off;
     // A branch crossing this one near the trunk may have taken its near part out with it;
     // its way back then leads into the trunk, which a side arm's does not.
-    if (cut_off && !(config.branches.keep_cut_off && leadsBack(*cyl, seg, near)))
+    if (cut_off && !leads_back)
       return reject(candidate, near.segment, {BranchRejection::NOT_AT_THE_SURFACE, true});
     if (auto verdict = checkPlace(candidate, *cyl, attachment))
       return reject(candidate, near.segment, *verdict);
@@ -357,23 +357,26 @@ bool BranchSearch::leadsBack(const Cylinder& fit, const Cylinder& seg, const Nea
 /// returns. The line through the whole piece (a thin-cylinder fit to all its points, which a few
 /// of the crossing branch's returns do not turn) is the branch's: when the near part's fit does
 /// not lead back into the trunk and that line, within CUT_REFIT_MAX_TURN of it, does, the line
-/// replaces its axis. The radius stays the near part's.
-void BranchSearch::refitCutOff(const Candidate& candidate, const Cylinder& seg,
+/// replaces its axis. The radius stays the near part's. Returns whether the fit, as it now
+/// stands, leads back (leadsBack), which the surface check then reads.
+bool BranchSearch::refitCutOff(const Candidate& candidate, const Cylinder& seg,
                                const NearPart& near, Cylinder* cyl) {
   if (leadsBack(*cyl, seg, near))
-    return;
+    return true;
   Points piece;
   for (const int k : candidate.members)
     piece.push_back(candidates_.pts[k]);
   const auto whole = fitThinCylinder(piece, cyl->axis, context_.bands.sigma, 0.0,
                                      maxBranchRadius(seg), nextCutRefitSeed());
   if (!whole)
-    return;
+    return false;
   Cylinder line = *cyl;
   line.axis = whole->axis.dot(cyl->axis) < 0.0 ? -whole->axis : whole->axis;
   line.center = whole->center + (cyl->center - whole->center).dot(line.axis) * line.axis;
-  if (lineAngle(line.axis, cyl->axis) <= CUT_REFIT_MAX_TURN && leadsBack(line, seg, near))
-    *cyl = line;
+  if (lineAngle(line.axis, cyl->axis) > CUT_REFIT_MAX_TURN || !leadsBack(line, seg, near))
+    return false;
+  *cyl = line;
+  return true;
 }
 
 /// A fit along a side arm forking off a branch (missesLikeASideArm) is replaced by a fit along

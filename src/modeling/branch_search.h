@@ -124,7 +124,7 @@ class BranchSearch {
   void examine(const Candidate& candidate);
   NearPart nearPart(const std::vector<int>& cluster, double reach) const;
   bool leadsBack(const Cylinder& fit, const Cylinder& seg, const NearPart& near) const;
-  void refitCutOff(const Candidate& candidate, const Cylinder& seg, const NearPart& near,
+  bool refitCutOff(const Candidate& candidate, const Cylinder& seg, const NearPart& near,
                    Cylinder* cyl);
   bool refitAtFork(const Candidate& candidate, const Cylinder& seg, const Direction& guess,
                    NearPart* near, Cylinder* cyl, std::vector<int>* inliers, double* wood_radius);
