@@ -159,7 +159,8 @@ struct SliceLimits {
   SliceBounds bounds;
   const TrackedAxis* track = nullptr;                    ///< none: the trunk-wide bounds
   const std::vector<double>* expected_radius = nullptr;  ///< per slice; none: no continuity
-  double continuity = 0.0;  ///< share of the expected radius a RANSAC circle may differ by
+  double continuity = 0.0;     ///< share of the expected radius a RANSAC circle may differ by
+  double surface_sigma = 0.0;  ///< noise the surface mode's kernel is for (m); 0: the band's
 };
 
 /// What fitting the trunk's segments needs: the region sliced along its refined centreline,
@@ -206,7 +207,8 @@ Eigen::Vector2d trimmedMeanCentre(const Points2& plane, const Eigen::Vector2d& s
 }  // namespace
 
 std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const CircleRansacConfig& o,
-                                              bool surface, double min_radius, double max_radius) {
+                                              bool surface, double min_radius, double max_radius,
+                                              double surface_sigma) {
   std::vector<int> inliers;
   auto circle = ransacCircle(plane, o, &inliers);
   if (!circle)
@@ -220,8 +222,8 @@ std::optional<SliceCircle> measureSliceCircle(const Points2& plane, const Circle
   SliceCircle out{*circle, static_cast<int>(inliers.size()), false};
   if (surface) {
     // The surface under the branch bases: the mode of the distances from the centre.
-    if (const auto mode =
-            surfaceCircle(plane, *circle, sigmaOfBand(o.threshold), min_radius, max_radius)) {
+    const double kernel = surface_sigma > 0.0 ? surface_sigma : sigmaOfBand(o.threshold);
+    if (const auto mode = surfaceCircle(plane, *circle, kernel, min_radius, max_radius)) {
       out.circle = *mode;
       out.surface = true;
     }
@@ -304,8 +306,8 @@ void measureSlice(const Points& pts, const std::vector<int>& members, const Cent
   for (const int i : members)
     plane.emplace_back((pts[i] - origin).dot(u), (pts[i] - origin).dot(v));
   const SliceCircleOptions o = sliceCircleOptions(limits, n, origin, config);
-  const auto measured =
-      measureSliceCircle(plane, o.ransac, config.noise.correct_bias, o.min_radius, o.max_radius);
+  const auto measured = measureSliceCircle(plane, o.ransac, config.noise.correct_bias, o.min_radius,
+                                           o.max_radius, limits.surface_sigma);
   sl.outliers = sl.points - (measured ? measured->inliers : 0);
   sl.outlier_share = static_cast<double>(sl.outliers) / sl.points;
   if (!measured || measured->inliers < MIN_SLICE_POINTS / 2)
@@ -1214,6 +1216,17 @@ SlicedAxis refinedSlices(const Points& pts, const std::vector<int>& region,
   return out;
 }
 
+/// The noise a slice's surface mode reads its returns with (surfaceCircle's kernel): the one
+/// its band stands for on the range noise alone, at the trunk's table reading. The band itself
+/// keeps the search's scatter, which picks a circle among clutter; a kernel that wide took a
+/// thin trunk's footprint wings and branch bases into its mode, where a rig's pipe (whose
+/// scatter is its range noise) and the noise model (noise_bias.cpp) read with the narrower one.
+double surfaceKernelSigma(double table_sigma, const ModelerConfig& config) {
+  if (!config.noise.derive_parameters)
+    return 0.0;
+  return std::max(sigmaOfBand(config.fit.circle_threshold_m), table_sigma);
+}
+
 }  // namespace
 
 double trunkSurfaceBand(const TrunkModel& trunk, const ModelerConfig& config) {
@@ -1298,9 +1311,12 @@ TrunkModel modelTrunk(const Points& pts, const std::vector<int>& region,
   }
   if (config.fit.constrain || config.noise.derive_parameters || config.noise.correct_bias) {
     const auto expected = expectedRadii(sliced.slices);
-    const SliceLimits limits{circle_threshold, bounds, &track,
+    const SliceLimits limits{circle_threshold,
+                             bounds,
+                             &track,
                              config.fit.constrain ? &expected : nullptr,
-                             config.trunk.radius_continuity};
+                             config.trunk.radius_continuity,
+                             surfaceKernelSigma(trunk.table_sigma, config)};
     sliced.slices = computeSlices(pts, region, sliced, limits, trunk.table_sigma, config);
   }
   trunk.slices = sliced.slices;

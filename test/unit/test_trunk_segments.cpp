@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -367,6 +368,57 @@ TEST(TrunkNoise, TheRangeNoiseIsReadOffTheSlicesAroundScaffolds) {
   EXPECT_NEAR(b.noise_sigma, a.noise_sigma, 0.1 * a.noise_sigma);
   EXPECT_GT(b.search_sigma, 1.2 * b.noise_sigma);
   EXPECT_NEAR(a.search_sigma, a.noise_sigma, 0.05 * a.noise_sigma);
+}
+
+/// `pts` with range noise of sigma (m) off the trunk's axis, and a share of them pushed outward
+/// by |N(0, wing)| more: the returns a beam's footprint wings leave beside a thin section.
+Points noiseWithWings(Points pts, double sigma, double share, double wing, std::uint64_t seed) {
+  Rng rng(seed);
+  for (auto& p : pts) {
+    const Eigen::Vector3d out = Eigen::Vector3d(p.x(), p.y(), 0.0).normalized();
+    double d = rng.normal(0.0, sigma);
+    if (rng.uniform(0.0, 1.0) < share)
+      d += std::abs(rng.normal(0.0, wing));
+    p += d * out;
+  }
+  return pts;
+}
+
+/// The median of the slices' radii less the taper's, between 0.6 m and 0.1 m below the rods of
+/// trunkWithRodsAroundItsTop.
+double sliceExcessBelowTheRods(const TrunkModel& trunk) {
+  std::vector<double> excess;
+  for (const auto& sl : trunk.slices) {
+    const double z = sl.center.z();
+    if (sl.has_circle && z >= RODS_FROM_M - 0.6 && z < RODS_FROM_M - 0.1)
+      excess.push_back(sl.radius - taper(z));
+  }
+  std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
+  return excess.empty() ? 0.0 : excess[excess.size() / 2];
+}
+
+TEST(TrunkNoise, ScaffoldsAroundTheTopDoNotWidenTheSlicesBelowThem) {
+  // The scaffolds' rods make every slice's scatter (the search's) read twice the range noise.
+  // The slices below them read their surface mode with the range noise's kernel either way: one
+  // as wide as the search's took the footprint's wings into their radii (0.3-0.4 mm here).
+  const double sigma = 0.003;
+  const Track track = straightTrack(taper);
+  ModelerConfig config;
+  config.trunk_calibration = RadiusCalibration{};
+  const double r = taper(0.5 * HEIGHT);
+  for (const std::uint64_t seed : {5, 6, 7}) {
+    const Points alone = noiseWithWings(taperedTrunk(), sigma, 0.3, 0.008, seed);
+    const Points rods = noiseWithWings(trunkWithRodsAroundItsTop(), sigma, 0.3, 0.008, seed);
+    const TrunkModel a = modelTrunk(alone, allOf(alone), track.axis, r, config, track.radii);
+    const TrunkModel b = modelTrunk(rods, allOf(rods), track.axis, r, config, track.radii);
+    std::printf(
+        "[ INFO ] seed %d: scatter read %.2f mm alone, %.2f mm with the rods (noise %.2f mm); "
+        "below them the slices read %+.2f mm alone, %+.2f mm with them\n",
+        static_cast<int>(seed), 1000 * a.search_sigma, 1000 * b.search_sigma, 1000 * b.noise_sigma,
+        1000 * sliceExcessBelowTheRods(a), 1000 * sliceExcessBelowTheRods(b));
+    EXPECT_GT(b.search_sigma, 1.5 * a.search_sigma) << "seed " << seed;
+    EXPECT_NEAR(sliceExcessBelowTheRods(b), sliceExcessBelowTheRods(a), 0.00015) << "seed " << seed;
+  }
 }
 
 }  // namespace

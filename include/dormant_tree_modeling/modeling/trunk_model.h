@@ -109,12 +109,15 @@ struct SliceCircle {
 /// @brief The trunk step's estimator of one cross-section: a RANSAC circle; its centre from the
 /// disc's trimmed mean where the noise the band stands for (sigmaOfBand(options.threshold))
 /// exceeds a fifth of the radius; with
-/// `surface`, the mode circle of the surface (surfaceCircle, bandwidth sigmaOfBand(threshold))
-/// within [min_radius, max_radius]. The noise model (noise_bias.h) runs this very estimator.
+/// `surface`, the mode circle of the surface (surfaceCircle, bandwidth `surface_sigma`, or
+/// sigmaOfBand(threshold) when 0) within [min_radius, max_radius]. The noise model
+/// (noise_bias.h) runs this very estimator.
+/// @param surface_sigma the noise (m) the surface mode's kernel is for; 0: the band's
 /// @return nothing when RANSAC finds no circle
 std::optional<SliceCircle> measureSliceCircle(const Points2& plane,
                                               const CircleRansacConfig& options, bool surface,
-                                              double min_radius, double max_radius);
+                                              double min_radius, double max_radius,
+                                              double surface_sigma = 0.0);
 
 /// @brief Residual-based estimate of the range noise from the slice circles of thick trunk
 /// parts: 1.4826 MAD of the radial residuals, x sqrt(3/2) because a return's radial residual
