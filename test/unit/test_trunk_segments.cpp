@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -11,6 +10,7 @@
 
 #include "dormant_tree_modeling/common/error.h"
 #include "dormant_tree_modeling/common/random.h"
+#include "dormant_tree_modeling/common/statistics.h"
 #include "dormant_tree_modeling/modeling/modeler_config.h"
 #include "dormant_tree_modeling/modeling/radius_calibration.h"
 #include "dormant_tree_modeling/modeling/trunk_model.h"
@@ -341,12 +341,18 @@ TEST(TrunkSegments, TheTrunkEndsWhereItForks) {
   EXPECT_GT(top, FORK_M - 0.2);
 }
 
-/// `pts` with every point moved off the trunk's axis by Gaussian noise of sigma (m).
-Points radialNoise(Points pts, double sigma, std::uint64_t seed) {
+/// `pts` with every point moved off the trunk's axis by Gaussian noise of sigma (m) and, for a
+/// share of them, pushed outward by |N(0, wing)| more: the returns a beam's footprint wings
+/// leave beside a thin section. Without wings the draws are the noise's alone.
+Points radialNoise(Points pts, double sigma, std::uint64_t seed, double wing_share = 0.0,
+                   double wing = 0.0) {
   Rng rng(seed);
   for (auto& p : pts) {
-    const Eigen::Vector3d out(p.x(), p.y(), 0.0);
-    p += rng.normal(0.0, sigma) * out.normalized();
+    const Eigen::Vector3d out = Eigen::Vector3d(p.x(), p.y(), 0.0).normalized();
+    double d = rng.normal(0.0, sigma);
+    if (wing_share > 0.0 && rng.uniform(0.0, 1.0) < wing_share)
+      d += std::abs(rng.normal(0.0, wing));
+    p += d * out;
   }
   return pts;
 }
@@ -370,20 +376,6 @@ TEST(TrunkNoise, TheRangeNoiseIsReadOffTheSlicesAroundScaffolds) {
   EXPECT_NEAR(a.search_sigma, a.noise_sigma, 0.05 * a.noise_sigma);
 }
 
-/// `pts` with range noise of sigma (m) off the trunk's axis, and a share of them pushed outward
-/// by |N(0, wing)| more: the returns a beam's footprint wings leave beside a thin section.
-Points noiseWithWings(Points pts, double sigma, double share, double wing, std::uint64_t seed) {
-  Rng rng(seed);
-  for (auto& p : pts) {
-    const Eigen::Vector3d out = Eigen::Vector3d(p.x(), p.y(), 0.0).normalized();
-    double d = rng.normal(0.0, sigma);
-    if (rng.uniform(0.0, 1.0) < share)
-      d += std::abs(rng.normal(0.0, wing));
-    p += d * out;
-  }
-  return pts;
-}
-
 /// The median of the slices' radii less the taper's, between 0.6 m and 0.1 m below the rods of
 /// trunkWithRodsAroundItsTop.
 double sliceExcessBelowTheRods(const TrunkModel& trunk) {
@@ -393,8 +385,7 @@ double sliceExcessBelowTheRods(const TrunkModel& trunk) {
     if (sl.has_circle && z >= RODS_FROM_M - 0.6 && z < RODS_FROM_M - 0.1)
       excess.push_back(sl.radius - taper(z));
   }
-  std::nth_element(excess.begin(), excess.begin() + excess.size() / 2, excess.end());
-  return excess.empty() ? 0.0 : excess[excess.size() / 2];
+  return median(std::move(excess));
 }
 
 TEST(TrunkNoise, ScaffoldsAroundTheTopDoNotWidenTheSlicesBelowThem) {
@@ -407,8 +398,8 @@ TEST(TrunkNoise, ScaffoldsAroundTheTopDoNotWidenTheSlicesBelowThem) {
   config.trunk_calibration = RadiusCalibration{};
   const double r = taper(0.5 * HEIGHT);
   for (const std::uint64_t seed : {5, 6, 7}) {
-    const Points alone = noiseWithWings(taperedTrunk(), sigma, 0.3, 0.008, seed);
-    const Points rods = noiseWithWings(trunkWithRodsAroundItsTop(), sigma, 0.3, 0.008, seed);
+    const Points alone = radialNoise(taperedTrunk(), sigma, seed, 0.3, 0.008);
+    const Points rods = radialNoise(trunkWithRodsAroundItsTop(), sigma, seed, 0.3, 0.008);
     const TrunkModel a = modelTrunk(alone, allOf(alone), track.axis, r, config, track.radii);
     const TrunkModel b = modelTrunk(rods, allOf(rods), track.axis, r, config, track.radii);
     std::printf(
