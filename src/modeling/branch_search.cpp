@@ -53,6 +53,11 @@ constexpr double RAY_TUBE_RADIUS = 0.01;  // m
 constexpr double CUT_WALK_REACH = 1.0;  // m, beyond any fit's way back
 constexpr double CUT_FILL_SHARE = 0.2;
 constexpr int CUT_FILL_MIN_POINTS = 3;
+// A fit crossing the trunk at this angle or more meets it at a well-placed attachment (an error
+// across the fit's axis moves it no more along the trunk): its way back runs from its near end to
+// there, not on along its axis, whose direction error a 0.2 m piece turns into 1-2 cm at the
+// trunk.
+constexpr double WAY_MIN_TRUNK_ANGLE = 45.0 * DEG;
 // A cut-off piece's near part may hold what a crossing branch's extraction left of it (the
 // crossing branch's own returns beside it): its fit then turns from the branch by 5-10 deg.
 // The line through the whole piece replaces it when it turns by no more than this.
@@ -184,9 +189,26 @@ bool looksLikeWire(const Cylinder& c, const Cylinder& trunk_segment, const Point
   return samples > 0 && occupied >= WIRE_OCCUPIED_SHARE * samples;
 }
 
-/// Whether returns fill a fit's axis from inner_gap off the trunk surface out to the fit's
-/// nearest point (gap), at CUT_FILL_SHARE of the density around the fit's centre: a branch
-/// crossing another near the trunk is cut in two by the other's extraction, and its outer
+/// The way from a fit back to the trunk, as a line walked from its centre against its axis:
+/// for a fit crossing the trunk at WAY_MIN_TRUNK_ANGLE or more, from the fit's near end to where
+/// its axis passes the trunk's (the attachment); for a steeper one, whose attachment is
+/// ill-placed along the trunk, its own axis.
+Cylinder wayBack(const Cylinder& fit, const Cylinder& seg) {
+  if (lineAngle(fit.axis, seg.axis) < WAY_MIN_TRUNK_ANGLE)
+    return fit;
+  Eigen::Vector3d attachment;
+  lineGap(fit.center, fit.axis, seg.center, seg.axis, &attachment);
+  Cylinder way = fit;
+  way.center = fit.center - 0.5 * fit.length * fit.axis;
+  const Eigen::Vector3d out = way.center - attachment;
+  if (out.norm() > 0.0)
+    way.axis = out.normalized();
+  return way;
+}
+
+/// Whether returns fill a fit's way back (wayBack) from inner_gap off the trunk surface out to
+/// the fit's nearest point (gap), at CUT_FILL_SHARE of the density around the fit's centre: a
+/// branch crossing another near the trunk is cut in two by the other's extraction, and its outer
 /// part starts away from the surface, while a neighbour's tip or a shoot in the shell has air
 /// between it and the trunk.
 bool filledToSurface(const Cylinder& fit, const Cylinder& seg, const PointIndex& index,
@@ -203,9 +225,10 @@ bool filledToSurface(const Cylinder& fit, const Cylinder& seg, const PointIndex&
 
 bool walkToSurface(const Cylinder& fit, const Cylinder& seg, double inner_gap, double gap,
                    const std::function<bool(const Eigen::Vector3d&)>& visit) {
+  const Cylinder way = wayBack(fit, seg);
   double last = 1e300;
   for (double t = 0.0; t < CUT_WALK_REACH; t += CUT_WALK_STEP) {
-    const Eigen::Vector3d q = fit.center - t * fit.axis;
+    const Eigen::Vector3d q = way.center - t * way.axis;
     const double d = axisDistance(seg, q) - seg.radius;
     if (d < inner_gap || d > last)
       return true;

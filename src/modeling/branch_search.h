@@ -57,9 +57,10 @@ struct BranchContext {
   const std::vector<Eigen::Vector3d>& wire_directions;
 };
 
-/// @brief The walk along a fit's axis from its centre towards the trunk surface, in steps of
-/// CUT_WALK_STEP: calls visit(q) for each step at most `gap` off the surface, until
-/// `inner_gap` or the axis' closest approach to the trunk.
+/// @brief The walk from a fit towards the trunk surface, in steps of CUT_WALK_STEP: from its near
+/// end to where its axis passes the trunk's when it crosses the trunk at a clear angle, else
+/// along its axis from its centre. Calls visit(q) for each step at most `gap` off the surface,
+/// until `inner_gap` or the way's closest approach to the trunk.
 /// @return false when visit stopped the walk (returned false) or the walk ran out of reach
 bool walkToSurface(const Cylinder& fit, const Cylinder& seg, double inner_gap, double gap,
                    const std::function<bool(const Eigen::Vector3d&)>& visit);
