@@ -29,11 +29,13 @@ const Eigen::Vector3d AROUND(std::cos(-9.0 * M_PI / 180), std::sin(-9.0 * M_PI /
 const Eigen::Vector3d RISING =
     std::cos(40.0 * M_PI / 180) * AROUND + std::sin(40.0 * M_PI / 180) * Eigen::Vector3d::UnitZ();
 
+// Where the level branches leave the 3 cm trunk.
+const Eigen::Vector3d BRANCH_BASE(0.03, 0, 0.9);
+
 /// A level branch leaving the 3 cm trunk at z 0.9 m: its returns from `from` to `to` metres
 /// off the trunk surface.
-void addBranchPart(Points& pts, double from, double to) {
-  const Eigen::Vector3d surface(0.03, 0, 0.9);
-  addCylinder(pts, surface + from * OUT, OUT, BRANCH_RADIUS, to - from);
+void addBranchPart(Points& pts, double from, double to, double radius = BRANCH_RADIUS) {
+  addCylinder(pts, BRANCH_BASE + from * OUT, OUT, radius, to - from);
 }
 
 int countReason(const std::vector<RejectedBranch>& rejected, BranchRejection reason) {
@@ -119,15 +121,14 @@ Points turnedPieceScene(unsigned seed, std::size_t* trunk_points, std::vector<ch
   Points pts;
   addCylinder(pts, {0, 0, 0}, {0, 0, 1}, 0.03, 1.5);
   *trunk_points = pts.size();
-  const Eigen::Vector3d surface(0.03, 0, 0.9);
-  addCylinder(pts, surface, OUT, 0.0066, 0.14);
+  addBranchPart(pts, 0.0, 0.14, 0.0066);
   const std::size_t base_end = pts.size();
   *outer_axis = Eigen::AngleAxisd(15.0 * M_PI / 180, Eigen::Vector3d::UnitZ()) * OUT;
-  addCylinder(pts, surface + 0.14 * OUT, *outer_axis, 0.0066, 0.28);
+  addCylinder(pts, BRANCH_BASE + 0.14 * OUT, *outer_axis, 0.0066, 0.28);
   addIsotropicNoise(pts, 0.002, seed);
   taken->assign(pts.size(), 0);
   for (std::size_t k = *trunk_points; k < base_end; ++k)
-    (*taken)[k] = (pts[k] - surface).dot(OUT) > 0.07;
+    (*taken)[k] = (pts[k] - BRANCH_BASE).dot(OUT) > 0.07;
   return pts;
 }
 
